@@ -1,0 +1,140 @@
+// Typed YAML configuration with errors that name the file, line and key.
+//
+// A module's config is a plain struct with defaults; a `load(ConfigMap&)` function reads the
+// keys it knows. Reading is strict: a key the struct does not read, a value of the wrong type
+// or a value outside its range is an error, because a silently ignored typo in a benchmark
+// config produces wrong figures that look right.
+//
+//   struct MapperConfig { double resolution = 0.1; int max_range_px = 5; };
+//   void load(semx::runtime::ConfigMap& m, MapperConfig& c) {
+//     m.get("resolution", c.resolution, 0.01, 1.0);
+//     m.get("max_range_px", c.max_range_px);
+//   }
+//   auto cfg = semx::runtime::load_config_file<MapperConfig>("mapper.yaml");
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace semx::runtime {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A view of one YAML mapping. Keys are recorded as they are read so finish() can report the
+// ones nobody asked for.
+class ConfigMap {
+ public:
+  // `source` names where the node came from (a file path, "--set", ...) for error messages.
+  ConfigMap(YAML::Node node, std::string source, std::string path = "");
+
+  static ConfigMap from_file(const std::string& file);
+  static ConfigMap from_string(const std::string& text, const std::string& source);
+  static ConfigMap empty(const std::string& source = "<defaults>");
+
+  bool has(const std::string& key) const;
+
+  // Reads `key` into `out` if present; leaves the default otherwise.
+  template <class T>
+  void get(const std::string& key, T& out);
+  // As get(), and rejects values outside [lo, hi].
+  template <class T>
+  void get(const std::string& key, T& out, T lo, T hi);
+  // As get(), for a string that must be one of `choices`.
+  void get_choice(const std::string& key, std::string& out, const std::vector<std::string>& choices);
+
+  // A nested mapping; an absent key gives an empty map (all defaults).
+  ConfigMap child(const std::string& key);
+  // A nested sequence of mappings (e.g. a list of processes).
+  std::vector<ConfigMap> children(const std::string& key);
+
+  // Throws if any key anywhere in the document (this map, and every child or list entry opened
+  // from it) was never read. Call it once, on the root, after the whole struct is loaded.
+  void finish() const;
+
+  // "file:line:col" of `key`, or of this map when key is empty.
+  std::string where(const std::string& key = "") const;
+  const std::string& source() const { return source_; }
+  const YAML::Node& node() const { return node_; }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+ private:
+  std::string qualified(const std::string& key) const;
+  YAML::Node value(const std::string& key);
+
+  struct ReadLog {
+    std::map<std::string, std::set<std::string>> keys;  // map path -> keys read there
+  };
+  ConfigMap(YAML::Node node, std::string source, std::string path, std::shared_ptr<ReadLog> log);
+  void check_unread(const YAML::Node& node, const std::string& path) const;
+
+  YAML::Node node_;
+  std::string source_;
+  std::string path_;  // dotted key path of this map inside the document, "" at the root
+  std::shared_ptr<ReadLog> log_;
+};
+
+// Applies "a.b.c=value" overrides (from --set flags) onto a YAML document before it is read.
+void apply_override(YAML::Node& root, const std::string& assignment);
+
+// Loads a config struct from a file (or defaults when `file` is empty) plus overrides.
+// `load` must be findable by ADL: void load(ConfigMap&, T&).
+template <class T>
+T load_config(const std::string& file, const std::vector<std::string>& overrides = {});
+
+// ---- implementation of the templates ----
+
+namespace detail {
+template <class T>
+const char* type_name();
+template <class T>
+bool convert(const YAML::Node& node, T& out);
+}  // namespace detail
+
+template <class T>
+void ConfigMap::get(const std::string& key, T& out) {
+  YAML::Node v = value(key);
+  if (!v) return;
+  T parsed{};
+  if (!detail::convert(v, parsed)) {
+    fail(key, std::string("expected ") + detail::type_name<T>());
+  }
+  out = parsed;
+}
+
+template <class T>
+void ConfigMap::get(const std::string& key, T& out, T lo, T hi) {
+  T parsed = out;
+  get(key, parsed);
+  if (!(parsed >= lo && parsed <= hi)) {
+    fail(key, "value " + YAML::Dump(YAML::Node(parsed)) + " is outside [" + YAML::Dump(YAML::Node(lo)) +
+                  ", " + YAML::Dump(YAML::Node(hi)) + "]");
+  }
+  out = parsed;
+}
+
+template <class T>
+T load_config(const std::string& file, const std::vector<std::string>& overrides) {
+  ConfigMap map = file.empty() ? ConfigMap::empty() : ConfigMap::from_file(file);
+  if (!overrides.empty()) {
+    YAML::Node root = map.node();
+    if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+    for (const auto& o : overrides) apply_override(root, o);
+    map = ConfigMap(root, file.empty() ? std::string("--set") : file + " + --set");
+  }
+  T cfg{};
+  load(map, cfg);
+  map.finish();
+  return cfg;
+}
+
+}  // namespace semx::runtime

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs every Debian package semx needs. Idempotent: installs only what is missing, so a
+# second run costs one dpkg query. Needs root (or sudo) when something is missing.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake pkg-config git ca-certificates
+  # messaging: LCM library, lcm-gen, lcm-logger/lcm-logplayer, Java bindings for lcm-spy
+  liblcm-dev liblcm-bin liblcm-java libglib2.0-dev default-jdk-headless libjchart2d-java
+  # maths, maps, perception, config
+  libeigen3-dev liboctomap-dev libpcl-dev libopencv-dev libyaml-cpp-dev zlib1g-dev
+  libnanoflann-dev liblbfgspp-dev libnlopt-cxx-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # headless display for lcm-spy and viewer checks; process tools for the launcher tests
+  xvfb procps iproute2
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "semx: installing ${#missing[@]} missing Debian packages: ${missing[*]}" >&2
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then sudo="sudo"; else
+    echo "semx: missing packages and not root (no sudo): ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "semx: packages installed" >&2
