@@ -1,0 +1,62 @@
+// The source of simulation time (DESIGN.md §3): decides when the next SIM_CLOCK tick is due.
+// Logic only; the simulator and semx-clock publish what it decides.
+//
+// REALTIME: tick k is due at wall time start + k * period / speed, and nobody is waited for.
+// LOCKSTEP: tick k+1 is due as soon as every registered node has acked tick k; while some have
+// not, tick k is resent every `resend_after_s` (wall) so a node that started late or restarted
+// still gets it. Acks are matched by node name and tick, so duplicates and strays are harmless.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "semx/runtime/sim_clock.hpp"
+
+namespace semx::runtime {
+
+struct ClockServerConfig {
+  ClockMode mode = ClockMode::kRealtime;
+  int64_t period_us = 10000;  // 100 Hz: the odometry rate
+  double speed = 1.0;         // REALTIME only
+  std::vector<std::string> lockstep_nodes;  // LOCKSTEP: who must ack every tick
+  double resend_after_s = 0.5;
+  int64_t max_ticks = -1;  // stop after this many ticks (-1: never)
+};
+
+struct ClockTick {
+  int64_t tick;
+  int64_t utime;
+  bool resend;  // the same tick again, not a new one
+};
+
+class ClockServer {
+ public:
+  explicit ClockServer(ClockServerConfig config);
+
+  // What to publish at wall time `wall_s` (monotonic seconds), if anything.
+  std::optional<ClockTick> poll(double wall_s);
+  // Records an ack; returns true if it completed the current tick's set.
+  bool on_ack(const std::string& node, int64_t tick);
+
+  bool finished() const;              // max_ticks reached (and acked, in LOCKSTEP)
+  int64_t current_tick() const { return tick_; }
+  int64_t current_utime() const { return tick_ < 0 ? 0 : tick_ * config_.period_us; }
+  std::vector<std::string> waiting_for() const;  // LOCKSTEP: nodes that have not acked yet
+  double seconds_waiting(double wall_s) const { return wall_s - tick_sent_at_; }
+  const ClockServerConfig& config() const { return config_; }
+
+ private:
+  bool tick_complete() const;
+
+  ClockServerConfig config_;
+  int64_t tick_ = -1;
+  double start_wall_ = -1;
+  double tick_sent_at_ = 0;
+  double last_send_ = 0;
+  std::set<std::string> acked_;
+};
+
+}  // namespace semx::runtime

@@ -1,0 +1,18 @@
+// Where a process talks: the LCM provider URL.
+#pragma once
+
+#include <string>
+
+namespace semx::runtime {
+
+// Loopback-only (ttl=0: nothing leaves the host) with a receive buffer large enough that 1 MB
+// camera frames at 30 Hz are not dropped by the kernel (DESIGN.md §6).
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+
+// The flag's value if given, else $LCM_DEFAULT_URL, else kDefaultLcmUrl.
+std::string resolve_lcm_url(const std::string& flag_value);
+
+// A loopback udpm URL on its own port, so tests running in parallel do not hear each other.
+std::string udpm_url_for_port(int port);
+
+}  // namespace semx::runtime

@@ -1,0 +1,219 @@
+// The LCM side of every semx process: typed, validated subscriptions, publishing, the
+// simulation clock, the NODE_STATUS heartbeat and clean shutdown.
+//
+// Every byte that arrives is counted. A message is handed to a handler only after its wire
+// layout was checked (wire_validator.hpp), the generated decoder succeeded inside try/catch and
+// the optional `accept` predicate agreed; anything else is counted as malformed and dropped.
+// Exceptions from handlers are caught and counted: nothing a sender does can escape handle().
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+#include <semx/ack_t.hpp>
+#include <semx/clock_t.hpp>
+#include <semx/node_status_t.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/sim_clock.hpp"
+#include "semx/runtime/wire_validator.hpp"
+
+namespace semx::runtime {
+
+class NodeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct NodeOptions {
+  std::string name;
+  std::string lcm_url;              // empty: resolve_lcm_url("")
+  bool lockstep = false;            // ack every SIM_CLOCK tick (a registered lockstep node)
+  bool follow_clock = true;         // subscribe to SIM_CLOCK (off for the clock's source)
+  double status_period_s = 1.0;     // NODE_STATUS heartbeat, wall clock
+  std::size_t max_message_bytes = 32u << 20;  // larger messages are dropped unread
+  bool quiet = false;               // no log lines for dropped messages
+};
+
+struct ChannelCounters {
+  bool outgoing = false;
+  int64_t messages = 0;
+  int64_t malformed = 0;
+  int64_t dropped = 0;
+  int64_t bytes = 0;
+};
+
+struct NodeCounters {
+  int64_t received = 0;
+  int64_t sent = 0;
+  int64_t dropped = 0;
+  int64_t malformed = 0;
+  int64_t handler_errors = 0;
+};
+
+enum class NodeState : int8_t { kStarting = 0, kRunning = 1, kDegraded = 2, kDone = 3, kStopping = 4, kFailed = 5 };
+const char* to_string(NodeState s);
+
+// Set by SIGINT/SIGTERM once install_shutdown_handlers() ran.
+void install_shutdown_handlers();
+bool shutdown_requested();
+void request_shutdown();
+
+class Node {
+ public:
+  explicit Node(NodeOptions options);
+  ~Node();
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  const std::string& name() const { return options_.name; }
+  const std::string& url() const { return options_.lcm_url; }
+
+  // Typed subscription to one channel. `accept` may reject decoded messages whose content is
+  // unusable (NaN poses, inconsistent sizes): they count as malformed.
+  template <class T>
+  void subscribe(const std::string& channel, std::function<void(const T&)> handler,
+                 std::function<bool(const T&)> accept = nullptr);
+  // Raw bytes of every channel matching `regex` (tools: monitors, recorders).
+  using RawHandler = std::function<void(const std::string& channel, const uint8_t* data, std::size_t size)>;
+  void subscribe_raw(const std::string& regex, RawHandler handler);
+
+  template <class T>
+  bool publish(const std::string& channel, const T& msg);
+  bool publish_raw(const std::string& channel, const void* data, std::size_t size);
+
+  // Called for each new SIM_CLOCK tick, before this node acks it in LOCKSTEP.
+  void on_tick(std::function<void(int64_t tick, int64_t utime)> fn) { tick_handlers_.push_back(std::move(fn)); }
+  const SimClock& clock() const { return clock_; }
+  int64_t now_utime() const { return clock_.now_utime(); }
+  // For the clock's source, which does not follow SIM_CLOCK: its own current time.
+  void set_time(int64_t utime, int64_t tick);
+
+  void set_state(NodeState state, const std::string& detail = "");
+  NodeState state() const { return state_; }
+
+  // Handles messages for up to `timeout_ms`; sends the heartbeat when due. Returns false if the
+  // LCM provider failed.
+  bool spin_once(int timeout_ms);
+  // Spins until shutdown_requested() or stop(); returns a process exit code.
+  int run();
+  void stop() { stop_ = true; }
+  bool stopped() const { return stop_ || shutdown_requested(); }
+
+  const NodeCounters& counters() const { return counters_; }
+  const std::map<std::string, ChannelCounters>& incoming() const { return incoming_; }
+  const std::map<std::string, ChannelCounters>& outgoing() const { return outgoing_; }
+  semx::node_status_t status() const;
+  void publish_status();
+
+ private:
+  struct Subscription;
+  template <class T>
+  struct TypedSubscription;
+  enum class Outcome { kDelivered, kMalformed, kHandlerError };
+
+  void ensure_lcm_subscription(const std::string& channel);
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_clock_message(const semx::clock_t& msg);
+  void note_malformed(const std::string& channel, const std::string& why, std::size_t size);
+  void note_handler_error(const std::string& channel, const char* what);
+  const LcmStruct& schema_of(const char* type_name) const;
+
+  NodeOptions options_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::map<std::string, std::vector<std::unique_ptr<Subscription>>> subs_;
+  std::vector<std::pair<std::string, RawHandler>> raw_handlers_;
+  std::vector<uint8_t> encode_buffer_;
+  std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;
+  SimClock clock_;
+  NodeState state_ = NodeState::kStarting;
+  std::string detail_;
+  NodeCounters counters_;
+  std::map<std::string, ChannelCounters> incoming_;
+  std::map<std::string, ChannelCounters> outgoing_;
+  std::chrono::steady_clock::time_point next_status_;
+  bool stop_ = false;
+};
+
+// ---- templates ----
+
+struct Node::Subscription {
+  virtual ~Subscription() = default;
+  // Returns kMalformed with `why` set when the bytes are not a usable message.
+  virtual Outcome deliver(const uint8_t* data, std::size_t size, std::string& why) = 0;
+};
+
+template <class T>
+struct Node::TypedSubscription : Node::Subscription {
+  const LcmStruct* type;
+  std::function<void(const T&)> handler;
+  std::function<bool(const T&)> accept;
+
+  Outcome deliver(const uint8_t* data, std::size_t size, std::string& why) override {
+    const WireError e = validate_wire(LcmSchema::semx(), *type, T::getHash(), data, size);
+    if (e != WireError::kNone) {
+      why = to_string(e);
+      return Outcome::kMalformed;
+    }
+    T msg;
+    try {
+      if (msg.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) {
+        why = "decoder rejected";
+        return Outcome::kMalformed;
+      }
+      if (accept && !accept(msg)) {
+        why = "content rejected";
+        return Outcome::kMalformed;
+      }
+    } catch (const std::exception& ex) {
+      why = std::string("decoder threw: ") + ex.what();
+      return Outcome::kMalformed;
+    }
+    try {
+      handler(msg);
+    } catch (const std::exception& ex) {
+      why = ex.what();
+      return Outcome::kHandlerError;
+    } catch (...) {
+      why = "unknown exception";
+      return Outcome::kHandlerError;
+    }
+    return Outcome::kDelivered;
+  }
+};
+
+template <class T>
+void Node::subscribe(const std::string& channel, std::function<void(const T&)> handler,
+                     std::function<bool(const T&)> accept) {
+  auto sub = std::make_unique<TypedSubscription<T>>();
+  sub->type = &schema_of(T::getTypeName());
+  sub->handler = std::move(handler);
+  sub->accept = std::move(accept);
+  ensure_lcm_subscription(channel);
+  subs_[channel].push_back(std::move(sub));
+}
+
+template <class T>
+bool Node::publish(const std::string& channel, const T& msg) {
+  const int size = msg.getEncodedSize();
+  if (size < 0) return false;
+  encode_buffer_.resize(static_cast<std::size_t>(size));
+  if (msg.encode(encode_buffer_.data(), 0, size) != size) {
+    auto& c = outgoing_[channel];
+    c.outgoing = true;
+    ++c.dropped;
+    ++counters_.dropped;
+    return false;
+  }
+  return publish_raw(channel, encode_buffer_.data(), encode_buffer_.size());
+}
+
+}  // namespace semx::runtime

@@ -1,0 +1,66 @@
+#include "semx/runtime/clock_server.hpp"
+
+#include <stdexcept>
+
+namespace semx::runtime {
+
+ClockServer::ClockServer(ClockServerConfig config) : config_(std::move(config)) {
+  if (config_.period_us <= 0) throw std::invalid_argument("clock period must be positive");
+  if (config_.mode == ClockMode::kRealtime && !(config_.speed > 0)) {
+    throw std::invalid_argument("realtime speed factor must be positive");
+  }
+}
+
+bool ClockServer::tick_complete() const {
+  if (config_.mode != ClockMode::kLockstep) return true;
+  for (const auto& n : config_.lockstep_nodes) {
+    if (!acked_.count(n)) return false;
+  }
+  return true;
+}
+
+bool ClockServer::finished() const {
+  return config_.max_ticks >= 0 && tick_ + 1 >= config_.max_ticks && tick_complete();
+}
+
+std::optional<ClockTick> ClockServer::poll(double wall_s) {
+  if (start_wall_ < 0) start_wall_ = wall_s;
+  if (finished()) return std::nullopt;
+  bool due = false;
+  if (tick_ < 0) {
+    due = true;
+  } else if (config_.mode == ClockMode::kRealtime) {
+    due = wall_s >= start_wall_ + static_cast<double>(tick_ + 1) * config_.period_us * 1e-6 / config_.speed;
+  } else {
+    due = tick_complete();
+  }
+  if (due) {
+    ++tick_;
+    acked_.clear();
+    tick_sent_at_ = last_send_ = wall_s;
+    return ClockTick{tick_, current_utime(), false};
+  }
+  if (config_.mode == ClockMode::kLockstep && wall_s - last_send_ >= config_.resend_after_s) {
+    last_send_ = wall_s;
+    return ClockTick{tick_, current_utime(), true};
+  }
+  return std::nullopt;
+}
+
+bool ClockServer::on_ack(const std::string& node, int64_t tick) {
+  if (tick != tick_ || config_.mode != ClockMode::kLockstep) return false;
+  const bool was_complete = tick_complete();
+  acked_.insert(node);
+  return !was_complete && tick_complete();
+}
+
+std::vector<std::string> ClockServer::waiting_for() const {
+  std::vector<std::string> out;
+  if (config_.mode != ClockMode::kLockstep) return out;
+  for (const auto& n : config_.lockstep_nodes) {
+    if (!acked_.count(n)) out.push_back(n);
+  }
+  return out;
+}
+
+}  // namespace semx::runtime
