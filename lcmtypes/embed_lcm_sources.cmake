@@ -1,6 +1,6 @@
 # Writes a C++ file holding each .lcm file's text, so the runtime can derive wire layouts from the
 # very files lcm-gen compiled (one source of truth, no hand-kept tables).
-separate_arguments(files UNIX_COMMAND "${FILES}")
+string(REPLACE "|" ";" files "${FILES}")
 set(body "// Generated from lcmtypes/*.lcm by embed_lcm_sources.cmake. Do not edit.\n")
 string(APPEND body "#include <string_view>\n#include <vector>\n\nnamespace semx::lcmtypes {\n")
 string(APPEND body "struct LcmSource { std::string_view file; std::string_view text; };\n")

@@ -95,7 +95,7 @@ ConfigMap::ConfigMap(YAML::Node node, std::string source, std::string path)
 
 ConfigMap::ConfigMap(YAML::Node node, std::string source, std::string path, std::shared_ptr<ReadLog> log)
     : node_(std::move(node)), source_(std::move(source)), path_(std::move(path)), log_(std::move(log)) {
-  if (node_ && !node_.IsNull() && !node_.IsMap()) {
+  if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
     throw ConfigError(where() + ": " + (path_.empty() ? std::string("document") : "'" + path_ + "'") +
                       " must be a mapping of key: value");
   }
@@ -123,7 +123,9 @@ ConfigMap ConfigMap::from_string(const std::string& text, const std::string& sou
 
 ConfigMap ConfigMap::empty(const std::string& source) { return ConfigMap(YAML::Node(), source); }
 
-bool ConfigMap::has(const std::string& key) const { return node_ && node_.IsMap() && node_[key]; }
+bool ConfigMap::has(const std::string& key) const {
+  return node_.IsDefined() && node_.IsMap() && node_[key].IsDefined();
+}
 
 std::string ConfigMap::qualified(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
@@ -131,9 +133,10 @@ std::string ConfigMap::qualified(const std::string& key) const {
 
 std::string ConfigMap::where(const std::string& key) const {
   YAML::Mark mark = YAML::Mark::null_mark();
+  const YAML::Node& node = node_;
   if (!key.empty() && has(key)) {
-    mark = node_[key].Mark();
-  } else if (node_) {
+    mark = node[key].Mark();
+  } else if (node.IsDefined()) {
     mark = node_.Mark();
   }
   if (mark.is_null()) return source_;
@@ -144,10 +147,11 @@ void ConfigMap::fail(const std::string& key, const std::string& what) const {
   throw ConfigError(where(key) + ": '" + qualified(key) + "': " + what);
 }
 
-YAML::Node ConfigMap::value(const std::string& key) {
+std::optional<YAML::Node> ConfigMap::value(const std::string& key) {
   log_->keys[path_].insert(key);
-  if (!has(key)) return YAML::Node();
-  YAML::Node v = node_[key];
+  if (!has(key)) return std::nullopt;
+  const YAML::Node& node = node_;  // const access: operator[] must not insert the key
+  YAML::Node v = node[key];
   if (v.IsNull()) fail(key, "has no value");
   return v;
 }
@@ -167,15 +171,16 @@ void ConfigMap::get_choice(const std::string& key, std::string& out, const std::
 }
 
 ConfigMap ConfigMap::child(const std::string& key) {
-  YAML::Node v = value(key);
-  if (v && !v.IsMap()) fail(key, "expected a mapping of key: value");
-  return ConfigMap(v ? v : YAML::Node(), source_, qualified(key), log_);
+  const std::optional<YAML::Node> v = value(key);
+  if (v && !v->IsMap()) fail(key, "expected a mapping of key: value");
+  return ConfigMap(v ? *v : YAML::Node(), source_, qualified(key), log_);
 }
 
 std::vector<ConfigMap> ConfigMap::children(const std::string& key) {
-  YAML::Node v = value(key);
+  const std::optional<YAML::Node> opt = value(key);
   std::vector<ConfigMap> out;
-  if (!v) return out;
+  if (!opt) return out;
+  const YAML::Node v = *opt;
   if (!v.IsSequence()) fail(key, "expected a list");
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string p = qualified(key) + "[" + std::to_string(i) + "]";

@@ -258,21 +258,27 @@ void Node::publish_status() {
                  std::chrono::microseconds(static_cast<int64_t>(options_.status_period_s * 1e6));
 }
 
-bool Node::spin_once(int timeout_ms) {
+int Node::spin_once(int timeout_ms) {
   const auto now = std::chrono::steady_clock::now();
   if (now >= next_status_) publish_status();
   const auto until_status =
       std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
   const int rc = lcm_->handleTimeout(wait);
-  return rc >= 0;
+  return rc < 0 ? -1 : (rc > 0 ? 1 : 0);
+}
+
+int Node::drain() {
+  int n = 0;
+  while (spin_once(0) > 0) ++n;
+  return n;
 }
 
 int Node::run() {
   if (state_ == NodeState::kStarting) set_state(NodeState::kRunning);
   int rc = 0;
   while (!stopped()) {
-    if (!spin_once(100)) {
+    if (spin_once(100) < 0) {
       if (shutdown_requested()) break;  // a signal interrupted the wait
       set_state(NodeState::kFailed, "LCM provider failed");
       rc = 1;

@@ -17,6 +17,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -69,7 +70,8 @@ class ConfigMap {
 
  private:
   std::string qualified(const std::string& key) const;
-  YAML::Node value(const std::string& key);
+  // The value of `key` (marking it read), or nullopt when absent.
+  std::optional<YAML::Node> value(const std::string& key);
 
   struct ReadLog {
     std::map<std::string, std::set<std::string>> keys;  // map path -> keys read there
@@ -102,10 +104,10 @@ bool convert(const YAML::Node& node, T& out);
 
 template <class T>
 void ConfigMap::get(const std::string& key, T& out) {
-  YAML::Node v = value(key);
+  const std::optional<YAML::Node> v = value(key);
   if (!v) return;
   T parsed{};
-  if (!detail::convert(v, parsed)) {
+  if (!detail::convert(*v, parsed)) {
     fail(key, std::string("expected ") + detail::type_name<T>());
   }
   out = parsed;

@@ -99,9 +99,11 @@ class Node {
   void set_state(NodeState state, const std::string& detail = "");
   NodeState state() const { return state_; }
 
-  // Handles messages for up to `timeout_ms`; sends the heartbeat when due. Returns false if the
-  // LCM provider failed.
-  bool spin_once(int timeout_ms);
+  // Waits up to `timeout_ms` for a message and handles it; sends the heartbeat when due.
+  // Returns 1 if a message was handled, 0 on timeout, -1 if the LCM provider failed.
+  int spin_once(int timeout_ms);
+  // Handles everything already queued, without waiting; returns how many messages.
+  int drain();
   // Spins until shutdown_requested() or stop(); returns a process exit code.
   int run();
   void stop() { stop_ = true; }

@@ -1,0 +1,108 @@
+#include <gtest/gtest.h>
+
+#include "semx/runtime/clock_server.hpp"
+#include "semx/runtime/sim_clock.hpp"
+
+using namespace semx::runtime;
+
+TEST(SimClock, NewTicksRunWorkAndAckOnlyInLockstep) {
+  SimClock participant(true), observer(false);
+  auto d = participant.on_clock(0, 0, ClockMode::kLockstep);
+  EXPECT_TRUE(d.new_tick);
+  EXPECT_TRUE(d.ack);
+  d = observer.on_clock(0, 0, ClockMode::kLockstep);
+  EXPECT_TRUE(d.new_tick);
+  EXPECT_FALSE(d.ack);
+  d = participant.on_clock(1, 10000, ClockMode::kRealtime);
+  EXPECT_TRUE(d.new_tick);
+  EXPECT_FALSE(d.ack) << "nobody acks a realtime clock";
+  EXPECT_EQ(participant.now_utime(), 10000);
+}
+
+TEST(SimClock, ResentTickIsReackedWithoutWork) {
+  SimClock c(true);
+  c.on_clock(5, 50000, ClockMode::kLockstep);
+  const auto d = c.on_clock(5, 50000, ClockMode::kLockstep);
+  EXPECT_FALSE(d.new_tick);
+  EXPECT_TRUE(d.ack);
+}
+
+TEST(SimClock, StaleTicksAreIgnoredAndTickZeroResets) {
+  SimClock c(true);
+  c.on_clock(5, 50000, ClockMode::kLockstep);
+  auto d = c.on_clock(3, 30000, ClockMode::kLockstep);
+  EXPECT_FALSE(d.new_tick);
+  EXPECT_FALSE(d.ack);
+  EXPECT_EQ(c.now_utime(), 50000);
+  d = c.on_clock(0, 0, ClockMode::kLockstep);
+  EXPECT_TRUE(d.new_tick);
+  EXPECT_TRUE(d.reset);
+  EXPECT_EQ(c.now_utime(), 0);
+  EXPECT_FALSE(c.on_clock(-1, 0, ClockMode::kLockstep).new_tick);
+}
+
+TEST(SimClock, TimeNeverRunsBackwardsWithinAnEpisode) {
+  SimClock c;
+  c.on_clock(1, 1000, ClockMode::kRealtime);
+  c.on_clock(2, 500, ClockMode::kRealtime);
+  EXPECT_EQ(c.now_utime(), 1000);
+}
+
+TEST(ClockServer, LockstepWaitsForEveryRegisteredNode) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"mapper", "planner"};
+  cfg.resend_after_s = 1.0;
+  ClockServer s(cfg);
+  auto t = s.poll(0.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 0);
+  EXPECT_FALSE(s.poll(0.1)) << "no acks yet";
+  EXPECT_FALSE(s.on_ack("mapper", 0));
+  EXPECT_FALSE(s.on_ack("stranger", 0));
+  EXPECT_FALSE(s.on_ack("planner", 7)) << "an ack for another tick does not count";
+  EXPECT_EQ(s.waiting_for(), std::vector<std::string>{"planner"});
+  EXPECT_FALSE(s.poll(0.2));
+  EXPECT_TRUE(s.on_ack("planner", 0));
+  t = s.poll(0.2);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 1);
+  EXPECT_EQ(t->utime, cfg.period_us);
+  EXPECT_FALSE(t->resend);
+}
+
+TEST(ClockServer, LockstepResendsAStalledTick) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"late"};
+  cfg.resend_after_s = 0.5;
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(0.0));
+  EXPECT_FALSE(s.poll(0.4));
+  auto t = s.poll(0.6);
+  ASSERT_TRUE(t);
+  EXPECT_TRUE(t->resend);
+  EXPECT_EQ(t->tick, 0);
+}
+
+TEST(ClockServer, RealtimeFollowsTheWallClockAtItsSpeed) {
+  ClockServerConfig cfg;
+  cfg.period_us = 10000;
+  cfg.speed = 2.0;  // a 10 ms tick every 5 ms of wall time
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(100.0));
+  EXPECT_FALSE(s.poll(100.004));
+  auto t = s.poll(100.005);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 1);
+}
+
+TEST(ClockServer, StopsAfterMaxTicks) {
+  ClockServerConfig cfg;
+  cfg.max_ticks = 2;
+  ClockServer s(cfg);
+  EXPECT_TRUE(s.poll(0));
+  EXPECT_TRUE(s.poll(1));
+  EXPECT_TRUE(s.finished());
+  EXPECT_FALSE(s.poll(2));
+}

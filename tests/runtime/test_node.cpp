@@ -1,0 +1,186 @@
+// The node runtime over memq:// (one process, publish and handle on the same LCM object).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <random>
+#include <semx/ack_t.hpp>
+#include <semx/clock_t.hpp>
+#include <semx/node_status_t.hpp>
+#include <semx/odometry_t.hpp>
+#include <semx/path_t.hpp>
+
+#include "semx/runtime/channels.hpp"
+#include "semx/runtime/node.hpp"
+#include "semx/runtime/wire_generator.hpp"
+
+using namespace semx::runtime;
+
+namespace {
+
+NodeOptions memq(const std::string& name, bool lockstep = false) {
+  NodeOptions o;
+  o.name = name;
+  o.lcm_url = "memq://";
+  o.lockstep = lockstep;
+  o.status_period_s = 1000;  // heartbeats only when a test asks
+  o.quiet = true;
+  return o;
+}
+
+void drain(Node& n) { n.drain(); }
+
+semx::odometry_t odom(double x) {
+  semx::odometry_t m{};
+  m.utime = 1;
+  m.position[0] = x;
+  m.orientation[0] = 1;
+  return m;
+}
+
+int64_t rss_kb() {
+  std::ifstream statm("/proc/self/statm");
+  long total = 0, resident = 0;
+  statm >> total >> resident;
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+}  // namespace
+
+TEST(Node, TypedRoundTripIsCounted) {
+  Node n(memq("t"));
+  std::vector<double> xs;
+  n.subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t& m) { xs.push_back(m.position[0]); });
+  ASSERT_TRUE(n.publish("ODOMETRY", odom(1.5)));
+  ASSERT_TRUE(n.publish("ODOMETRY", odom(2.5)));
+  drain(n);
+  EXPECT_EQ(xs, (std::vector<double>{1.5, 2.5}));
+  EXPECT_EQ(n.incoming().at("ODOMETRY").bytes, n.outgoing().at("ODOMETRY").bytes);
+  EXPECT_EQ(n.incoming().at("ODOMETRY").messages, 2);
+  EXPECT_EQ(n.outgoing().at("ODOMETRY").messages, 2);
+}
+
+TEST(Node, HostileBytesAreCountedDroppedAndNeverReachTheHandler) {
+  Node n(memq("victim"));
+  int delivered = 0;
+  n.subscribe<semx::path_t>("PLAN_PATH", [&](const semx::path_t&) { ++delivered; });
+  const auto& schema = LcmSchema::semx();
+  const auto& type = *schema.find("semx.path_t");
+  std::mt19937_64 rng(3);
+  const int64_t rss_before = rss_kb();
+  int sent = 0;
+  for (auto kind : {HostileKind::kTruncated, HostileKind::kOversized, HostileKind::kNegativeLength,
+                    HostileKind::kHugeLength, HostileKind::kWrongFingerprint}) {
+    for (int i = 0; i < 20; ++i) {
+      const auto bytes = hostile_wire_message(schema, type, kind, rng);
+      n.publish_raw("PLAN_PATH", bytes.data(), bytes.size());
+      ++sent;
+    }
+  }
+  drain(n);
+  EXPECT_EQ(delivered, 0);
+  EXPECT_EQ(n.counters().malformed, sent);
+  EXPECT_EQ(n.incoming().at("PLAN_PATH").malformed, sent);
+  // A decoder trusting the huge lengths would have tried to reserve gigabytes.
+  EXPECT_LT(rss_kb() - rss_before, 20 * 1024);
+
+  // Still alive and serving.
+  semx::path_t good{};
+  good.num_waypoints = 1;
+  good.waypoints = {{1, 2, 3}};
+  good.yaws = {0.5};
+  n.publish("PLAN_PATH", good);
+  drain(n);
+  EXPECT_EQ(delivered, 1);
+}
+
+TEST(Node, ContentCheckRejectsAsMalformed) {
+  Node n(memq("t"));
+  int delivered = 0;
+  n.subscribe<semx::odometry_t>(
+      "ODOMETRY", [&](const semx::odometry_t&) { ++delivered; },
+      [](const semx::odometry_t& m) { return std::isfinite(m.position[0]); });
+  n.publish("ODOMETRY", odom(std::nan("")));
+  n.publish("ODOMETRY", odom(1));
+  drain(n);
+  EXPECT_EQ(delivered, 1);
+  EXPECT_EQ(n.counters().malformed, 1);
+}
+
+TEST(Node, OversizedMessagesAreDroppedUnread) {
+  auto o = memq("t");
+  o.max_message_bytes = 1000;
+  Node n(o);
+  int delivered = 0;
+  n.subscribe<semx::path_t>("PLAN_PATH", [&](const semx::path_t&) { ++delivered; });
+  semx::path_t big{};
+  big.num_waypoints = 100;
+  big.waypoints.assign(100, std::vector<double>(3, 0.0));
+  big.yaws.assign(100, 0.0);
+  n.publish("PLAN_PATH", big);
+  drain(n);
+  EXPECT_EQ(delivered, 0);
+  EXPECT_EQ(n.counters().dropped, 1);
+  EXPECT_EQ(n.counters().malformed, 0);
+}
+
+TEST(Node, HandlerExceptionsAreCaughtAndCounted) {
+  Node n(memq("t"));
+  n.subscribe<semx::odometry_t>("ODOMETRY", [](const semx::odometry_t&) { throw std::runtime_error("bug"); });
+  n.publish("ODOMETRY", odom(1));
+  n.publish("ODOMETRY", odom(2));
+  drain(n);
+  EXPECT_EQ(n.counters().handler_errors, 2);
+  EXPECT_GE(n.spin_once(0), 0) << "the LCM object is still usable after a throwing handler";
+}
+
+TEST(Node, LockstepNodeDoesTickWorkThenAcks) {
+  Node n(memq("mapper", true));
+  std::vector<std::string> order;
+  n.on_tick([&](int64_t tick, int64_t) {
+    order.push_back("work" + std::to_string(tick));
+    n.publish("ODOMETRY", odom(static_cast<double>(tick)));
+  });
+  n.subscribe<semx::ack_t>("SIM_ACK", [&](const semx::ack_t& a) {
+    EXPECT_EQ(a.node, "mapper");
+    order.push_back("ack" + std::to_string(a.tick));
+  });
+  n.subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t&) { order.push_back("out"); });
+  for (int64_t tick : {0, 1, 1, 2}) {
+    semx::clock_t c{};
+    c.utime = tick * 10000;
+    c.tick = tick;
+    c.mode = semx::clock_t::LOCKSTEP;
+    n.publish("SIM_CLOCK", c);
+    drain(n);
+  }
+  EXPECT_EQ(order, (std::vector<std::string>{"work0", "out", "ack0", "work1", "out", "ack1", "ack1", "work2",
+                                             "out", "ack2"}));
+  EXPECT_EQ(n.now_utime(), 20000);
+}
+
+TEST(Node, StatusCarriesCountersAndState) {
+  Node n(memq("statusy"));
+  std::vector<semx::node_status_t> seen;
+  n.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t& s) { seen.push_back(s); });
+  const std::vector<uint8_t> junk{1, 2, 3};
+  n.publish_raw("NODE_STATUS", junk.data(), junk.size());
+  drain(n);
+  n.set_state(NodeState::kDegraded, "testing");
+  drain(n);
+  ASSERT_FALSE(seen.empty());
+  const auto& s = seen.back();
+  EXPECT_EQ(s.node, "statusy");
+  EXPECT_EQ(s.pid, getpid());
+  EXPECT_EQ(s.state, static_cast<int8_t>(NodeState::kDegraded));
+  EXPECT_EQ(s.detail, "testing");
+  EXPECT_EQ(s.malformed, 1);
+  EXPECT_GT(s.rss_kb, 0);
+  EXPECT_EQ(s.num_channels, static_cast<int32_t>(s.channels.size()));
+}
+
+TEST(Node, BadUrlIsAClearError) {
+  auto o = memq("t");
+  o.lcm_url = "bogus://nowhere";
+  EXPECT_THROW({ Node n(o); }, NodeError);
+}
