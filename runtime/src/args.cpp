@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
@@ -143,6 +144,8 @@ std::string ArgParser::help() const {
 }
 
 int run_main(const std::string& program, const std::function<int()>& body) {
+  // Processes usually write into the launcher's pipes: line-buffer so lines arrive as they happen.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     return body();
   } catch (const ArgError& e) {

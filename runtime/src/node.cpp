@@ -265,7 +265,8 @@ int Node::spin_once(int timeout_ms) {
       std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
   const int rc = lcm_->handleTimeout(wait);
-  return rc < 0 ? -1 : (rc > 0 ? 1 : 0);
+  if (rc < 0) return shutdown_requested() ? 0 : -1;  // a signal interrupting the wait is not a failure
+  return rc > 0 ? 1 : 0;
 }
 
 int Node::drain() {
@@ -279,7 +280,6 @@ int Node::run() {
   int rc = 0;
   while (!stopped()) {
     if (spin_once(100) < 0) {
-      if (shutdown_requested()) break;  // a signal interrupted the wait
       set_state(NodeState::kFailed, "LCM provider failed");
       rc = 1;
       break;

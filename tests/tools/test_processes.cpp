@@ -1,0 +1,204 @@
+// Real processes over udpm: a launched set in lockstep recorded by lcm-logger and read back with
+// lcm::LogFile, Ctrl-C leaving nothing behind, restart and failure policies, and a node under a
+// stream of hostile messages.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <semx/ack_t.hpp>
+#include <semx/clock_t.hpp>
+#include <semx/node_status_t.hpp>
+
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "process_harness.hpp"
+#include "semx/runtime/node.hpp"
+
+using namespace semx::testing;
+
+namespace {
+
+std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/semx_" + std::to_string(getpid()) + "_" + name; }
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<pid_t> started_pids(const std::string& output) {
+  std::vector<pid_t> pids;
+  const std::regex re("started \\(pid ([0-9]+)\\)");
+  for (std::sregex_iterator it(output.begin(), output.end(), re), end; it != end; ++it) {
+    pids.push_back(static_cast<pid_t>(std::stol((*it)[1].str())));
+  }
+  return pids;
+}
+
+}  // namespace
+
+TEST(Processes, LockstepSetIsRecordedAndReadBack) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(1));
+  const std::string log = temp_path("lockstep.lcmlog");
+  const std::string set = temp_path("lockstep.yaml");
+  constexpr int kTicks = 200;
+  std::ofstream(set) << "name: lockstep-test\nprocesses:\n"
+                        "  - name: logger\n    command: [lcm-logger, --quiet, --force, \"" << log << "\"]\n"
+                        "    required: false\n"
+                        "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+                        "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
+                        "--ticks, \"" << kTicks << "\"]\n    ends_set: true\n    start_delay: 1.0\n";
+  const std::string out = temp_path("lockstep.out");
+  Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--grace", "3"}, out);
+  ASSERT_EQ(launcher.wait(30), 0) << read_file(out);
+  for (pid_t pid : started_pids(read_file(out))) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " left behind";
+
+  lcm::LogFile file(log, "r");
+  ASSERT_TRUE(file.good()) << log;
+  std::vector<int64_t> ticks;           // new ticks, in log order
+  std::map<int64_t, std::size_t> acked;  // tick -> position of the monitor's first ack
+  std::set<std::string> status_nodes;
+  std::size_t position = 0;
+  while (const lcm::LogEvent* ev = file.readNextEvent()) {
+    ++position;
+    if (ev->channel == "SIM_CLOCK") {
+      semx::clock_t c;
+      ASSERT_EQ(c.decode(ev->data, 0, ev->datalen), ev->datalen);
+      EXPECT_EQ(c.mode, semx::clock_t::LOCKSTEP);
+      if (ticks.empty() || c.tick > ticks.back()) {
+        // A new tick is only published once every registered node acked the previous one.
+        if (!ticks.empty()) {
+          EXPECT_TRUE(acked.count(ticks.back())) << "tick " << c.tick << " before ack";
+        }
+        EXPECT_EQ(c.utime, c.tick * c.period_us);
+        ticks.push_back(c.tick);
+      }
+    } else if (ev->channel == "SIM_ACK") {
+      semx::ack_t a;
+      ASSERT_EQ(a.decode(ev->data, 0, ev->datalen), ev->datalen);
+      EXPECT_EQ(a.node, "monitor");
+      acked.emplace(a.tick, position);
+    } else if (ev->channel == "NODE_STATUS") {
+      semx::node_status_t s;
+      ASSERT_EQ(s.decode(ev->data, 0, ev->datalen), ev->datalen);
+      status_nodes.insert(s.node);
+    }
+  }
+  ASSERT_EQ(static_cast<int>(ticks.size()), kTicks);
+  for (int i = 0; i < kTicks; ++i) EXPECT_EQ(ticks[static_cast<std::size_t>(i)], i);
+  EXPECT_EQ(static_cast<int>(acked.size()), kTicks);
+  EXPECT_TRUE(status_nodes.count("clock"));
+  EXPECT_TRUE(status_nodes.count("monitor"));
+}
+
+TEST(Processes, CtrlCStopsTheWholeSetAndLeavesNothingBehind) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(2));
+  const std::string out = temp_path("ctrlc.out");
+  Process launcher({bin("semx-launch"), "foundation", "--lcm-url", url, "--no-color"}, out);
+  // Wait until both processes have started.
+  for (int i = 0; i < 100 && started_pids(read_file(out)).size() < 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const auto pids = started_pids(read_file(out));
+  ASSERT_EQ(pids.size(), 2u) << read_file(out);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  for (pid_t pid : pids) EXPECT_TRUE(pid_alive(pid));
+  launcher.signal(SIGINT);
+  EXPECT_EQ(launcher.wait(15), 130) << read_file(out);
+  for (pid_t pid : pids) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " left behind";
+  EXPECT_NE(read_file(out).find("caught SIGINT"), std::string::npos);
+}
+
+TEST(Processes, LauncherKilledHardTakesItsChildrenWithIt) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(3));
+  const std::string out = temp_path("kill9.out");
+  Process launcher({bin("semx-launch"), "foundation", "--lcm-url", url, "--no-color"}, out);
+  for (int i = 0; i < 100 && started_pids(read_file(out)).size() < 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const auto pids = started_pids(read_file(out));
+  ASSERT_EQ(pids.size(), 2u);
+  launcher.signal(SIGKILL);
+  launcher.wait(5);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  for (pid_t pid : pids) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " orphaned";
+}
+
+TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
+  const std::string set = temp_path("fail.yaml");
+  std::ofstream(set) << "name: fail-test\nprocesses:\n"
+                        "  - name: flaky\n    command: [/bin/sh, -c, \"echo partial-line-no-newline; exit 3\"]\n"
+                        "    restart: on-failure\n    max_restarts: 2\n    restart_delay: 0.1\n"
+                        "  - name: sleeper\n    command: [/bin/sleep, \"60\"]\n";
+  const std::string out = temp_path("fail.out");
+  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  EXPECT_EQ(launcher.wait(20), 1);
+  const std::string text = read_file(out);
+  EXPECT_NE(text.find("restart 2/2"), std::string::npos) << text;
+  EXPECT_NE(text.find("required process failed"), std::string::npos) << text;
+  EXPECT_NE(text.find("flaky   | partial-line-no-newline"), std::string::npos) << "output is prefixed:\n" << text;
+  for (pid_t pid : started_pids(text)) EXPECT_FALSE(pid_alive(pid));
+}
+
+TEST(Processes, MissingProgramAndBadSetAreClearErrors) {
+  const std::string set = temp_path("missing.yaml");
+  std::ofstream(set) << "name: m\nprocesses:\n  - name: ghost\n    command: [semx-does-not-exist]\n";
+  const std::string out = temp_path("missing.out");
+  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  EXPECT_EQ(launcher.wait(10), 1);
+  EXPECT_NE(read_file(out).find("cannot run 'semx-does-not-exist'"), std::string::npos) << read_file(out);
+
+  const std::string out2 = temp_path("badset.out");
+  Process bad({bin("semx-launch"), "no-such-set"}, out2);
+  EXPECT_EQ(bad.wait(10), 2);
+  EXPECT_NE(read_file(out2).find("no process set 'no-such-set'"), std::string::npos) << read_file(out2);
+}
+
+TEST(Processes, NodeSurvivesHostileMessagesWithBoundedMemory) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(4));
+  Process monitor({bin("semx-monitor"), "--status-period", "0.2", "--interval", "60", "--quiet"},
+                  temp_path("victim.out"), url);
+  semx::runtime::NodeOptions o;
+  o.name = "observer";
+  o.lcm_url = url;
+  o.quiet = true;
+  semx::runtime::Node observer(o);
+  struct {
+    semx::node_status_t last;
+    bool seen = false;
+  } watch;
+  observer.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t& s) {
+    if (s.node == "monitor") {
+      watch.last = s;
+      watch.seen = true;
+    }
+  });
+  auto listen = [&](double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) observer.spin_once(50);
+  };
+  listen(1.0);
+  ASSERT_TRUE(watch.seen) << "monitor never reported";
+  const int64_t rss_before = watch.last.rss_kb;
+
+  // 5 kinds x 40 messages that can never be well-formed, then noise and bit flips.
+  Process hostile({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000", "--kinds",
+                   "truncated,oversized,negative-length,huge-length,wrong-fingerprint"},
+                  temp_path("hostile.out"), url);
+  ASSERT_EQ(hostile.wait(20), 0);
+  Process noise({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000", "--kinds",
+                 "random-bytes,bit-flip", "--seed", "9"},
+                temp_path("noise.out"), url);
+  ASSERT_EQ(noise.wait(20), 0);
+  listen(1.0);
+
+  EXPECT_TRUE(monitor.alive()) << "the node died";
+  EXPECT_GE(watch.last.malformed, 200) << "hostile messages not counted";
+  EXPECT_LT(watch.last.rss_kb - rss_before, 20 * 1024) << "memory grew under hostile input";
+  EXPECT_EQ(watch.last.handler_errors, 0);
+  monitor.signal(SIGINT);
+  EXPECT_EQ(monitor.wait(5), 0);
+}

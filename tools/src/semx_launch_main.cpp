@@ -1,0 +1,91 @@
+// semx-launch: starts a process set (tools/launch/*.yaml) and supervises it. See docs/launch.md.
+#include <unistd.h>
+
+#include <climits>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "semx/runtime/args.hpp"
+#include "semx/tools/launch_set.hpp"
+#include "semx/tools/supervisor.hpp"
+
+using namespace semx::runtime;
+using namespace semx::tools;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string executable_dir() {
+  char buf[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return ".";
+  buf[n] = '\0';
+  return fs::path(buf).parent_path().string();
+}
+
+std::string source_root() {
+  if (const char* env = std::getenv("SEMX_ROOT")) return env;
+  return SEMX_SOURCE_DIR;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("semx-launch", [&] {
+    std::string set_name, lcm_url;
+    std::vector<std::string> arg_list;
+    double duration = 0, grace = 5;
+    bool list = false, no_color = false;
+    ArgParser p("semx-launch",
+                "Starts a process set and supervises it: output prefixed by process name, restarts as the set\n"
+                "says, Ctrl-C stops everything. SET is a file or a name in tools/launch/ (without .yaml).");
+    p.positional("SET", "the process set", &set_name)
+        .repeated("arg", "NAME=VALUE", "set one of the set's args (see --list)", &arg_list)
+        .option("lcm-url", "URL", "LCM provider for every process (exported as LCM_DEFAULT_URL)", &lcm_url)
+        .option("duration", "S", "stop the set after S wall seconds", &duration)
+        .option("grace", "S", "seconds between SIGINT and SIGKILL when stopping (default 5)", &grace)
+        .flag("list", "print the set's args and processes and exit", &list)
+        .flag("no-color", "do not colour process names", &no_color);
+    if (!p.parse(argc, argv)) return 0;
+
+    const std::string root = source_root();
+    std::string file = set_name;
+    if (!fs::exists(file)) file = root + "/tools/launch/" + set_name + ".yaml";
+    if (!fs::exists(file)) {
+      std::string known;
+      if (fs::is_directory(root + "/tools/launch")) {
+        for (const auto& e : fs::directory_iterator(root + "/tools/launch")) {
+          if (e.path().extension() == ".yaml") known += " " + e.path().stem().string();
+        }
+      }
+      throw ArgError("no process set '" + set_name + "' (a file, or one of:" + known + ")");
+    }
+    std::map<std::string, std::string> overrides;
+    for (const auto& a : arg_list) {
+      const auto eq = a.find('=');
+      if (eq == std::string::npos || eq == 0) throw ArgError("--arg '" + a + "': expected NAME=VALUE");
+      overrides[a.substr(0, eq)] = a.substr(eq + 1);
+    }
+    SupervisorOptions o;
+    o.bin_dir = executable_dir();
+    o.root_dir = root;
+    o.lcm_url = lcm_url;
+    o.duration_s = duration;
+    o.grace_s = grace;
+    o.color = !no_color && isatty(STDOUT_FILENO);
+    const LaunchSet set = load_launch_set(file, overrides, {{"root", root}, {"bin", o.bin_dir}});
+    if (list) {
+      std::cout << set.name << ": " << set.description << "\nargs:\n";
+      for (const auto& [k, v] : set.args) std::cout << "  " << k << " = " << v << "\n";
+      std::cout << "processes:\n";
+      for (const auto& proc : set.processes) {
+        std::cout << "  " << proc.name << ":";
+        for (const auto& w : proc.command) std::cout << " " << w;
+        std::cout << "\n";
+      }
+      return 0;
+    }
+    return run_launch_set(set, o);
+  });
+}

@@ -1,0 +1,330 @@
+#include "semx/tools/supervisor.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <iostream>
+#include <vector>
+
+namespace semx::tools {
+
+namespace {
+
+int g_signal_pipe[2] = {-1, -1};
+
+extern "C" void on_supervisor_signal(int sig) {
+  const int saved = errno;
+  const char c = static_cast<char>(sig);
+  [[maybe_unused]] ssize_t n = write(g_signal_pipe[1], &c, 1);
+  errno = saved;
+}
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct Child {
+  const ProcessSpec* spec;
+  pid_t pid = -1;
+  int out_fd = -1;
+  std::string partial;
+  int restarts = 0;
+  double start_at = 0;  // when to (re)start, if pid < 0 and pending
+  bool pending = true;
+  bool finished = false;
+  const char* color = "";
+};
+
+const char* kColors[] = {"\033[36m", "\033[32m", "\033[33m", "\033[35m", "\033[34m", "\033[91m", "\033[92m"};
+
+std::string resolve_program(const std::string& program, const SupervisorOptions& o) {
+  if (program.find('/') != std::string::npos) {
+    return program[0] == '/' ? program : o.root_dir + "/" + program;
+  }
+  const std::string in_bin = o.bin_dir + "/" + program;
+  struct stat st {};
+  if (!o.bin_dir.empty() && stat(in_bin.c_str(), &st) == 0 && (st.st_mode & S_IXUSR)) return in_bin;
+  return program;  // execvp searches PATH
+}
+
+class Supervisor {
+ public:
+  Supervisor(const LaunchSet& set, const SupervisorOptions& o) : set_(set), o_(o) {
+    std::size_t width = 0;
+    for (const auto& p : set.processes) width = std::max(width, p.name.size());
+    width_ = width;
+    int k = 0;
+    const double t0 = now_s();
+    for (const auto& p : set.processes) {
+      Child c;
+      c.spec = &p;
+      c.start_at = t0 + p.start_delay_s;
+      c.color = o.color ? kColors[k++ % 7] : "";
+      children_.push_back(c);
+    }
+  }
+
+  int run() {
+    const double t0 = now_s();
+    say("set '" + set_.name + "': " + std::to_string(children_.size()) + " processes" +
+        (o_.lcm_url.empty() ? "" : " on " + o_.lcm_url));
+    while (true) {
+      const double t = now_s();
+      if (!stopping_ && o_.duration_s > 0 && t - t0 >= o_.duration_s) {
+        say("duration of " + std::to_string(o_.duration_s) + " s reached");
+        begin_stop(0);
+      }
+      if (!stopping_) {
+        for (auto& c : children_) {
+          if (c.pending && t >= c.start_at) start(c);
+          if (stopping_) break;
+        }
+      }
+      if (stopping_ && t >= kill_at_ && !killed_) {
+        for (auto& c : children_) {
+          if (c.pid > 0) {
+            say(c, "did not stop within " + std::to_string(o_.grace_s) + " s: SIGKILL");
+            kill(-c.pid, SIGKILL);
+          }
+        }
+        killed_ = true;
+      }
+      bool any_alive = false, any_pending = false;
+      for (const auto& c : children_) {
+        any_alive |= c.pid > 0;
+        any_pending |= c.pending && !stopping_;
+      }
+      if (!any_alive && (!any_pending || stopping_)) break;
+      wait_io(stopping_ ? 50 : 100);
+      reap();
+    }
+    for (auto& c : children_) flush(c);
+    if (exit_code_ == 0) say("set '" + set_.name + "' ended");
+    return exit_code_;
+  }
+
+ private:
+  void say(const std::string& msg) { std::cout << "[semx-launch] " << msg << std::endl; }
+  void say(const Child& c, const std::string& msg) { say(c.spec->name + ": " + msg); }
+
+  void emit_line(const Child& c, const std::string& line) {
+    std::string name = c.spec->name;
+    name.resize(width_, ' ');
+    std::cout << c.color << name << (o_.color ? "\033[0m" : "") << " | " << line << "\n";
+  }
+
+  void flush(Child& c) {
+    if (c.out_fd >= 0) {
+      drain(c);
+      close(c.out_fd);
+      c.out_fd = -1;
+    }
+    if (!c.partial.empty()) {
+      emit_line(c, c.partial);
+      c.partial.clear();
+    }
+    std::cout.flush();
+  }
+
+  void drain(Child& c) {
+    char buf[4096];
+    while (c.out_fd >= 0) {
+      const ssize_t n = read(c.out_fd, buf, sizeof buf);
+      if (n <= 0) {
+        if (n == 0) {
+          close(c.out_fd);
+          c.out_fd = -1;
+        }
+        break;
+      }
+      c.partial.append(buf, static_cast<std::size_t>(n));
+      std::size_t nl;
+      while ((nl = c.partial.find('\n')) != std::string::npos) {
+        emit_line(c, c.partial.substr(0, nl));
+        c.partial.erase(0, nl + 1);
+      }
+      // A process that never ends its line must not grow us without bound.
+      if (c.partial.size() > 65536) {
+        emit_line(c, c.partial);
+        c.partial.clear();
+      }
+    }
+    std::cout.flush();
+  }
+
+  void start(Child& c) {
+    c.pending = false;
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0) {
+      say(c, std::string("cannot create pipe: ") + std::strerror(errno));
+      fail(c);
+      return;
+    }
+    std::vector<std::string> argv_s = c.spec->command;
+    argv_s[0] = resolve_program(argv_s[0], o_);
+    const pid_t parent = getpid();
+    const pid_t pid = fork();
+    if (pid < 0) {
+      say(c, std::string("fork failed: ") + std::strerror(errno));
+      close(fds[0]);
+      close(fds[1]);
+      fail(c);
+      return;
+    }
+    if (pid == 0) {
+      setpgid(0, 0);
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != parent) _exit(127);  // the supervisor died before prctl took effect
+      signal(SIGINT, SIG_DFL);
+      signal(SIGTERM, SIG_DFL);
+      signal(SIGPIPE, SIG_DFL);
+      sigset_t none;
+      sigemptyset(&none);
+      sigprocmask(SIG_SETMASK, &none, nullptr);
+      dup2(fds[1], STDOUT_FILENO);
+      dup2(fds[1], STDERR_FILENO);
+      const int devnull = open("/dev/null", O_RDONLY);
+      if (devnull >= 0) dup2(devnull, STDIN_FILENO);
+      if (!o_.lcm_url.empty()) setenv("LCM_DEFAULT_URL", o_.lcm_url.c_str(), 1);
+      for (const auto& [k, v] : c.spec->env) setenv(k.c_str(), v.c_str(), 1);
+      std::vector<char*> argv;
+      for (auto& a : argv_s) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execvp(argv[0], argv.data());
+      dprintf(STDERR_FILENO, "cannot run '%s': %s\n", argv[0], std::strerror(errno));
+      _exit(127);
+    }
+    setpgid(pid, pid);  // also here, so a signal sent right away reaches the group
+    close(fds[1]);
+    fcntl(fds[0], F_SETFL, O_NONBLOCK);
+    c.pid = pid;
+    c.out_fd = fds[0];
+    say(c, "started (pid " + std::to_string(pid) + "): " + join(argv_s));
+  }
+
+  static std::string join(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& a : v) s += (s.empty() ? "" : " ") + a;
+    return s;
+  }
+
+  void wait_io(int timeout_ms) {
+    std::vector<pollfd> fds;
+    fds.push_back({g_signal_pipe[0], POLLIN, 0});
+    for (const auto& c : children_) {
+      if (c.out_fd >= 0) fds.push_back({c.out_fd, POLLIN, 0});
+    }
+    const int n = poll(fds.data(), fds.size(), timeout_ms);
+    if (n <= 0) return;
+    if (fds[0].revents & POLLIN) {
+      char sig[16];
+      const ssize_t k = read(g_signal_pipe[0], sig, sizeof sig);
+      for (ssize_t i = 0; i < k; ++i) {
+        if (sig[i] == SIGINT || sig[i] == SIGTERM) {
+          if (!stopping_) {
+            say(std::string("caught ") + (sig[i] == SIGINT ? "SIGINT" : "SIGTERM") + ": stopping all processes");
+            begin_stop(130);
+          } else if (!killed_) {
+            say("second signal: SIGKILL now");
+            kill_at_ = 0;
+          }
+        }
+      }
+    }
+    for (auto& c : children_) {
+      if (c.out_fd >= 0) drain(c);
+    }
+  }
+
+  void reap() {
+    while (true) {
+      int status = 0;
+      const pid_t pid = waitpid(-1, &status, WNOHANG);
+      if (pid <= 0) return;
+      for (auto& c : children_) {
+        if (c.pid != pid) continue;
+        c.pid = -1;
+        flush(c);
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        const std::string how = WIFEXITED(status) ? "exited with " + std::to_string(code)
+                                                  : std::string("killed by signal ") + strsignal(WTERMSIG(status));
+        const ExitAction action = on_process_exit(*c.spec, code, c.restarts, stopping_);
+        switch (action) {
+          case ExitAction::kRestart:
+            ++c.restarts;
+            say(c, how + ": restart " + std::to_string(c.restarts) + "/" + std::to_string(c.spec->max_restarts) +
+                       " in " + std::to_string(c.spec->restart_delay_s) + " s");
+            c.pending = true;
+            c.start_at = now_s() + c.spec->restart_delay_s;
+            break;
+          case ExitAction::kFailSet:
+            say(c, how + ": required process failed, stopping the set");
+            begin_stop(1);
+            break;
+          case ExitAction::kEndSet:
+            say(c, how + ": ends the set");
+            begin_stop(0);
+            break;
+          case ExitAction::kContinue:
+            say(c, how);
+            c.finished = true;
+            break;
+        }
+      }
+    }
+  }
+
+  void fail(Child& c) {
+    if (c.spec->required) {
+      begin_stop(1);
+    } else {
+      c.finished = true;
+    }
+  }
+
+  void begin_stop(int code) {
+    if (stopping_) return;
+    stopping_ = true;
+    exit_code_ = code;
+    kill_at_ = now_s() + o_.grace_s;
+    for (auto& c : children_) {
+      c.pending = false;
+      if (c.pid > 0) kill(-c.pid, SIGINT);
+    }
+  }
+
+  const LaunchSet& set_;
+  SupervisorOptions o_;
+  std::vector<Child> children_;
+  std::size_t width_ = 0;
+  bool stopping_ = false;
+  bool killed_ = false;
+  double kill_at_ = 0;
+  int exit_code_ = 0;
+};
+
+}  // namespace
+
+int run_launch_set(const LaunchSet& set, const SupervisorOptions& options) {
+  if (g_signal_pipe[0] < 0) {
+    if (pipe2(g_signal_pipe, O_CLOEXEC | O_NONBLOCK) != 0) throw std::runtime_error("cannot create signal pipe");
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_supervisor_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  return Supervisor(set, options).run();
+}
+
+}  // namespace semx::tools
