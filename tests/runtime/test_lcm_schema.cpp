@@ -79,3 +79,20 @@ TEST(LcmSchema, ErrorsNameFileAndLine) {
   EXPECT_THROW(LcmSchema::parse({{"u.lcm", "package p; struct a_t { q_t x; }"}}), LcmSchemaError);
   EXPECT_THROW(LcmSchema::parse({{"e.lcm", "package p; struct a_t { int32_t x;"}}), LcmSchemaError);
 }
+
+#include <fstream>
+#include <sstream>
+
+TEST(LcmSchema, MessagesDocNamesEveryChannelAndType) {
+  std::ifstream in(std::string(SEMX_SOURCE_DIR) + "/docs/messages.md");
+  ASSERT_TRUE(in.good());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string doc = ss.str();
+  for (const auto& c : semx::channels::kAll) {
+    EXPECT_NE(doc.find("`" + std::string(c.channel) + "`"), std::string::npos) << c.channel << " undocumented";
+  }
+  for (const auto& [name, s] : LcmSchema::semx().structs()) {
+    EXPECT_NE(doc.find("**`" + s.name + "`**"), std::string::npos) << s.name << " undocumented";
+  }
+}
