@@ -4,6 +4,7 @@
 #include <semx/node_status_t.hpp>
 
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
     node.set_state(NodeState::kRunning);
 
     const double start = wall_seconds();
+    board.update_rates(start);
     double next_report = start + interval;
     while (!node.stopped()) {
       if (node.spin_once(50) < 0) return 1;
@@ -71,7 +73,9 @@ int main(int argc, char** argv) {
       }
       if (now >= next_report) {
         board.update_rates(now);
-        std::cout << "--- " << board.nodes().size() << " nodes, " << (now - start) << " s ---\n"
+        char head[96];
+        std::snprintf(head, sizeof head, "--- %zu nodes, %.1f s ---\n", board.nodes().size(), now - start);
+        std::cout << head
                   << board.render_nodes(now);
         if (channels) std::cout << board.render_channels();
         std::cout.flush();
