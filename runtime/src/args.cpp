@@ -64,8 +64,8 @@ ArgParser& ArgParser::option(const std::string& name, const std::string& value_n
               }});
 }
 
-ArgParser& ArgParser::repeated(const std::string& name, const std::string& value_name, const std::string& help,
-                               std::vector<std::string>* out) {
+ArgParser& ArgParser::repeated(const std::string& name, const std::string& value_name,
+                               const std::string& help, std::vector<std::string>* out) {
   return add({name, value_name, help, [out](const std::string& v) { out->push_back(v); }});
 }
 
@@ -75,7 +75,8 @@ ArgParser& ArgParser::flag(const std::string& name, const std::string& help, boo
   return add(std::move(s));
 }
 
-ArgParser& ArgParser::positional(const std::string& name, const std::string& help, std::string* out, bool required) {
+ArgParser& ArgParser::positional(const std::string& name, const std::string& help, std::string* out,
+                                 bool required) {
   positionals_.push_back({name, help, out, required});
   return *this;
 }

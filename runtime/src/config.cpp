@@ -10,25 +10,45 @@ namespace semx::runtime {
 namespace detail {
 
 template <>
-const char* type_name<bool>() { return "a boolean (true/false)"; }
+const char* type_name<bool>() {
+  return "a boolean (true/false)";
+}
 template <>
-const char* type_name<int>() { return "an integer"; }
+const char* type_name<int>() {
+  return "an integer";
+}
 template <>
-const char* type_name<int64_t>() { return "an integer"; }
+const char* type_name<int64_t>() {
+  return "an integer";
+}
 template <>
-const char* type_name<uint32_t>() { return "a non-negative integer"; }
+const char* type_name<uint32_t>() {
+  return "a non-negative integer";
+}
 template <>
-const char* type_name<double>() { return "a number"; }
+const char* type_name<double>() {
+  return "a number";
+}
 template <>
-const char* type_name<float>() { return "a number"; }
+const char* type_name<float>() {
+  return "a number";
+}
 template <>
-const char* type_name<std::string>() { return "a string"; }
+const char* type_name<std::string>() {
+  return "a string";
+}
 template <>
-const char* type_name<std::vector<double>>() { return "a list of numbers"; }
+const char* type_name<std::vector<double>>() {
+  return "a list of numbers";
+}
 template <>
-const char* type_name<std::vector<int>>() { return "a list of integers"; }
+const char* type_name<std::vector<int>>() {
+  return "a list of integers";
+}
 template <>
-const char* type_name<std::vector<std::string>>() { return "a list of strings"; }
+const char* type_name<std::vector<std::string>>() {
+  return "a list of strings";
+}
 
 namespace {
 template <class T>
@@ -61,11 +81,17 @@ bool list(const YAML::Node& node, std::vector<T>& out) {
 }  // namespace
 
 template <>
-bool convert<bool>(const YAML::Node& n, bool& o) { return scalar(n, o); }
+bool convert<bool>(const YAML::Node& n, bool& o) {
+  return scalar(n, o);
+}
 template <>
-bool convert<int>(const YAML::Node& n, int& o) { return scalar(n, o); }
+bool convert<int>(const YAML::Node& n, int& o) {
+  return scalar(n, o);
+}
 template <>
-bool convert<int64_t>(const YAML::Node& n, int64_t& o) { return scalar(n, o); }
+bool convert<int64_t>(const YAML::Node& n, int64_t& o) {
+  return scalar(n, o);
+}
 template <>
 bool convert<uint32_t>(const YAML::Node& n, uint32_t& o) {
   int64_t v = 0;
@@ -74,15 +100,25 @@ bool convert<uint32_t>(const YAML::Node& n, uint32_t& o) {
   return true;
 }
 template <>
-bool convert<double>(const YAML::Node& n, double& o) { return floating(n, o); }
+bool convert<double>(const YAML::Node& n, double& o) {
+  return floating(n, o);
+}
 template <>
-bool convert<float>(const YAML::Node& n, float& o) { return floating(n, o); }
+bool convert<float>(const YAML::Node& n, float& o) {
+  return floating(n, o);
+}
 template <>
-bool convert<std::string>(const YAML::Node& n, std::string& o) { return scalar(n, o); }
+bool convert<std::string>(const YAML::Node& n, std::string& o) {
+  return scalar(n, o);
+}
 template <>
-bool convert<std::vector<double>>(const YAML::Node& n, std::vector<double>& o) { return list(n, o); }
+bool convert<std::vector<double>>(const YAML::Node& n, std::vector<double>& o) {
+  return list(n, o);
+}
 template <>
-bool convert<std::vector<int>>(const YAML::Node& n, std::vector<int>& o) { return list(n, o); }
+bool convert<std::vector<int>>(const YAML::Node& n, std::vector<int>& o) {
+  return list(n, o);
+}
 template <>
 bool convert<std::vector<std::string>>(const YAML::Node& n, std::vector<std::string>& o) {
   return list(n, o);
@@ -115,8 +151,8 @@ ConfigMap ConfigMap::from_string(const std::string& text, const std::string& sou
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                      ": YAML syntax error: " + e.msg);
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ":" +
+                      std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
   }
   return ConfigMap(root, source);
 }
@@ -156,7 +192,8 @@ std::optional<YAML::Node> ConfigMap::value(const std::string& key) {
   return v;
 }
 
-void ConfigMap::get_choice(const std::string& key, std::string& out, const std::vector<std::string>& choices) {
+void ConfigMap::get_choice(const std::string& key, std::string& out,
+                           const std::vector<std::string>& choices) {
   std::string v = out;
   get(key, v);
   for (const auto& c : choices) {
@@ -186,8 +223,8 @@ std::vector<ConfigMap> ConfigMap::children(const std::string& key) {
     const std::string p = qualified(key) + "[" + std::to_string(i) + "]";
     if (!v[i].IsMap()) {
       YAML::Mark m = v[i].Mark();
-      throw ConfigError(source_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": '" +
-                        p + "': expected a mapping of key: value");
+      throw ConfigError(source_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) +
+                        ": '" + p + "': expected a mapping of key: value");
     }
     out.push_back(ConfigMap(v[i], source_, p, log_));
   }

@@ -37,7 +37,8 @@ std::vector<Token> tokenize(const std::string& file, const std::string& text) {
       while (i < text.size() && text[i] != '\n') ++i;
     } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
       const std::size_t end = text.find("*/", i + 2);
-      if (end == std::string::npos) throw LcmSchemaError(file + ":" + std::to_string(line) + ": unterminated comment");
+      if (end == std::string::npos)
+        throw LcmSchemaError(file + ":" + std::to_string(line) + ": unterminated comment");
       line += static_cast<int>(std::count(text.begin() + i, text.begin() + end, '\n'));
       i = end + 2;
     } else if (punct.find(c) != std::string::npos) {
@@ -59,9 +60,11 @@ std::vector<Token> tokenize(const std::string& file, const std::string& text) {
 
 bool primitive_of(const std::string& t, LcmPrimitive& p) {
   static const std::pair<const char*, LcmPrimitive> table[] = {
-      {"int8_t", LcmPrimitive::kInt8},   {"int16_t", LcmPrimitive::kInt16}, {"int32_t", LcmPrimitive::kInt32},
-      {"int64_t", LcmPrimitive::kInt64}, {"float", LcmPrimitive::kFloat},   {"double", LcmPrimitive::kDouble},
-      {"string", LcmPrimitive::kString}, {"boolean", LcmPrimitive::kBoolean}, {"byte", LcmPrimitive::kByte}};
+      {"int8_t", LcmPrimitive::kInt8},   {"int16_t", LcmPrimitive::kInt16},
+      {"int32_t", LcmPrimitive::kInt32}, {"int64_t", LcmPrimitive::kInt64},
+      {"float", LcmPrimitive::kFloat},   {"double", LcmPrimitive::kDouble},
+      {"string", LcmPrimitive::kString}, {"boolean", LcmPrimitive::kBoolean},
+      {"byte", LcmPrimitive::kByte}};
   for (const auto& [name, prim] : table) {
     if (t == name) {
       p = prim;

@@ -23,7 +23,8 @@ std::atomic<bool> g_shutdown{false};
 extern "C" void on_signal(int) { g_shutdown.store(true); }
 
 int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
@@ -53,12 +54,18 @@ bool worth_logging(int64_t n) {
 
 const char* to_string(NodeState s) {
   switch (s) {
-    case NodeState::kStarting: return "starting";
-    case NodeState::kRunning: return "running";
-    case NodeState::kDegraded: return "degraded";
-    case NodeState::kDone: return "done";
-    case NodeState::kStopping: return "stopping";
-    case NodeState::kFailed: return "failed";
+    case NodeState::kStarting:
+      return "starting";
+    case NodeState::kRunning:
+      return "running";
+    case NodeState::kDegraded:
+      return "degraded";
+    case NodeState::kDone:
+      return "done";
+    case NodeState::kStopping:
+      return "stopping";
+    case NodeState::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -85,7 +92,8 @@ Node::Node(NodeOptions options) : options_(std::move(options)), clock_(options_.
     subscribe<semx::clock_t>(
         channels::SIM_CLOCK, [this](const semx::clock_t& m) { on_clock_message(m); },
         [](const semx::clock_t& m) {
-          return m.tick >= 0 && m.utime >= 0 && (m.mode == semx::clock_t::REALTIME || m.mode == semx::clock_t::LOCKSTEP);
+          return m.tick >= 0 && m.utime >= 0 &&
+                 (m.mode == semx::clock_t::REALTIME || m.mode == semx::clock_t::LOCKSTEP);
         });
   }
   next_status_ = std::chrono::steady_clock::now();
@@ -261,8 +269,7 @@ void Node::publish_status() {
 int Node::spin_once(int timeout_ms) {
   const auto now = std::chrono::steady_clock::now();
   if (now >= next_status_) publish_status();
-  const auto until_status =
-      std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
+  const auto until_status = std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
   const int rc = lcm_->handleTimeout(wait);
   if (rc < 0) return shutdown_requested() ? 0 : -1;  // a signal interrupting the wait is not a failure

@@ -32,7 +32,8 @@ struct Emitter {
       const LcmField& f = s.fields[fi];
       std::size_t count = 1;
       for (const auto& d : f.dims) {
-        count *= static_cast<std::size_t>(d.variable ? ints[static_cast<std::size_t>(d.field_index)] : d.size);
+        count *=
+            static_cast<std::size_t>(d.variable ? ints[static_cast<std::size_t>(d.field_index)] : d.size);
       }
       for (std::size_t k = 0; k < count; ++k) {
         switch (f.kind) {
@@ -97,20 +98,27 @@ std::vector<uint8_t> random_wire_message(const LcmSchema& schema, const LcmStruc
 
 const char* to_string(HostileKind k) {
   switch (k) {
-    case HostileKind::kTruncated: return "truncated";
-    case HostileKind::kOversized: return "oversized";
-    case HostileKind::kNegativeLength: return "negative-length";
-    case HostileKind::kHugeLength: return "huge-length";
-    case HostileKind::kWrongFingerprint: return "wrong-fingerprint";
-    case HostileKind::kRandomBytes: return "random-bytes";
-    case HostileKind::kBitFlip: return "bit-flip";
+    case HostileKind::kTruncated:
+      return "truncated";
+    case HostileKind::kOversized:
+      return "oversized";
+    case HostileKind::kNegativeLength:
+      return "negative-length";
+    case HostileKind::kHugeLength:
+      return "huge-length";
+    case HostileKind::kWrongFingerprint:
+      return "wrong-fingerprint";
+    case HostileKind::kRandomBytes:
+      return "random-bytes";
+    case HostileKind::kBitFlip:
+      return "bit-flip";
   }
   return "?";
 }
 
 std::vector<HostileKind> all_hostile_kinds() {
-  return {HostileKind::kTruncated,        HostileKind::kOversized,   HostileKind::kNegativeLength,
-          HostileKind::kHugeLength,       HostileKind::kWrongFingerprint, HostileKind::kRandomBytes,
+  return {HostileKind::kTruncated,  HostileKind::kOversized,        HostileKind::kNegativeLength,
+          HostileKind::kHugeLength, HostileKind::kWrongFingerprint, HostileKind::kRandomBytes,
           HostileKind::kBitFlip};
 }
 
@@ -135,7 +143,8 @@ std::vector<uint8_t> hostile_wire_message(const LcmSchema& schema, const LcmStru
       m.resize(rng() % m.size());
       break;
     case HostileKind::kOversized:
-      for (int i = 0, n = 1 + static_cast<int>(rng() % 64); i < n; ++i) m.push_back(static_cast<uint8_t>(rng()));
+      for (int i = 0, n = 1 + static_cast<int>(rng() % 64); i < n; ++i)
+        m.push_back(static_cast<uint8_t>(rng()));
       break;
     case HostileKind::kNegativeLength:
       rewrite_length(true);
@@ -151,7 +160,8 @@ std::vector<uint8_t> hostile_wire_message(const LcmSchema& schema, const LcmStru
       for (auto& b : m) b = static_cast<uint8_t>(rng());
       break;
     case HostileKind::kBitFlip:
-      for (int i = 0; i < 4 && m.size() > 8; ++i) m[8 + rng() % (m.size() - 8)] ^= static_cast<uint8_t>(1u << (rng() % 8));
+      for (int i = 0; i < 4 && m.size() > 8; ++i)
+        m[8 + rng() % (m.size() - 8)] ^= static_cast<uint8_t>(1u << (rng() % 8));
       break;
   }
   return m;

@@ -7,14 +7,22 @@ namespace semx::runtime {
 
 const char* to_string(WireError e) {
   switch (e) {
-    case WireError::kNone: return "ok";
-    case WireError::kTooShort: return "too short";
-    case WireError::kFingerprint: return "wrong fingerprint";
-    case WireError::kNegativeLength: return "negative array length";
-    case WireError::kLengthExceedsBuffer: return "array length exceeds message";
-    case WireError::kBadString: return "malformed string";
-    case WireError::kTrailingBytes: return "trailing bytes";
-    case WireError::kTooDeep: return "nesting too deep";
+    case WireError::kNone:
+      return "ok";
+    case WireError::kTooShort:
+      return "too short";
+    case WireError::kFingerprint:
+      return "wrong fingerprint";
+    case WireError::kNegativeLength:
+      return "negative array length";
+    case WireError::kLengthExceedsBuffer:
+      return "array length exceeds message";
+    case WireError::kBadString:
+      return "malformed string";
+    case WireError::kTrailingBytes:
+      return "trailing bytes";
+    case WireError::kTooDeep:
+      return "nesting too deep";
   }
   return "?";
 }
@@ -25,7 +33,8 @@ constexpr int kMaxDepth = 8;
 
 class Walker {
  public:
-  Walker(const LcmSchema& schema, const uint8_t* data, std::size_t size) : schema_(schema), data_(data), size_(size) {}
+  Walker(const LcmSchema& schema, const uint8_t* data, std::size_t size)
+      : schema_(schema), data_(data), size_(size) {}
 
   WireError walk(const LcmStruct& s, int depth) {
     if (depth > kMaxDepth) return WireError::kTooDeep;
@@ -44,7 +53,8 @@ class Walker {
       }
       const std::size_t left = size_ - pos_;
       if (f.kind == LcmPrimitive::kString) {
-        if (count > left / 5) return left < 4 && count == 1 ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
+        if (count > left / 5)
+          return left < 4 && count == 1 ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
         for (uint64_t k = 0; k < count; ++k) {
           if (size_ - pos_ < 4) return WireError::kTooShort;
           const int64_t len = read_int(4);
@@ -55,14 +65,16 @@ class Walker {
       } else if (f.kind == LcmPrimitive::kStruct) {
         const LcmStruct& sub = schema_.structs().at(f.struct_name);
         const std::size_t each = std::max<std::size_t>(1, schema_.min_encoded_size(sub));
-        if (count > left / each) return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
+        if (count > left / each)
+          return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
         for (uint64_t k = 0; k < count; ++k) {
           const WireError e = walk(sub, depth + 1);
           if (e != WireError::kNone) return e;
         }
       } else {
         const std::size_t each = primitive_size(f.kind);
-        if (count > left / each) return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
+        if (count > left / each)
+          return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
         if (f.dims.empty() && (f.kind == LcmPrimitive::kInt8 || f.kind == LcmPrimitive::kInt16 ||
                                f.kind == LcmPrimitive::kInt32 || f.kind == LcmPrimitive::kInt64)) {
           ints[fi] = read_int(each);
@@ -95,8 +107,8 @@ class Walker {
 
 }  // namespace
 
-WireError validate_wire(const LcmSchema& schema, const LcmStruct& type, int64_t fingerprint, const uint8_t* data,
-                        std::size_t size) {
+WireError validate_wire(const LcmSchema& schema, const LcmStruct& type, int64_t fingerprint,
+                        const uint8_t* data, std::size_t size) {
   if (data == nullptr || size < 8) return WireError::kTooShort;
   uint64_t hash = 0;
   for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[i];

@@ -60,8 +60,8 @@ TEST(Args, HelpStopsParsingAndRunMainMapsErrorsToExitCodes) {
   EXPECT_FALSE(parse(p, {"--help"}));
   EXPECT_NE(testing::internal::GetCapturedStdout().find("does things"), std::string::npos);
   testing::internal::CaptureStderr();
-  EXPECT_EQ(run_main("prog", [] () -> int { throw ArgError("bad flag"); }), 2);
-  EXPECT_EQ(run_main("prog", [] () -> int { throw std::runtime_error("boom"); }), 1);
+  EXPECT_EQ(run_main("prog", []() -> int { throw ArgError("bad flag"); }), 2);
+  EXPECT_EQ(run_main("prog", []() -> int { throw std::runtime_error("boom"); }), 1);
   EXPECT_EQ(run_main("prog", [] { return 0; }), 0);
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("prog: bad flag"), std::string::npos);

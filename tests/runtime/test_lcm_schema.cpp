@@ -12,12 +12,12 @@ using semx::runtime::LcmSchemaError;
 TEST(LcmSchema, FingerprintOfEveryTypeMatchesLcmGen) {
   const auto& schema = LcmSchema::semx();
   int checked = 0;
-#define CHECK_TYPE(T)                                                          \
-  {                                                                            \
-    const auto* s = schema.find("semx." #T);                                   \
-    ASSERT_NE(s, nullptr) << #T;                                               \
-    EXPECT_EQ(schema.fingerprint(*s), semx::T::getHash()) << #T;               \
-    ++checked;                                                                 \
+#define CHECK_TYPE(T)                                            \
+  {                                                              \
+    const auto* s = schema.find("semx." #T);                     \
+    ASSERT_NE(s, nullptr) << #T;                                 \
+    EXPECT_EQ(schema.fingerprint(*s), semx::T::getHash()) << #T; \
+    ++checked;                                                   \
   }
   SEMX_ALL_TYPES(CHECK_TYPE)
 #undef CHECK_TYPE
@@ -90,7 +90,8 @@ TEST(LcmSchema, MessagesDocNamesEveryChannelAndType) {
   ss << in.rdbuf();
   const std::string doc = ss.str();
   for (const auto& c : semx::channels::kAll) {
-    EXPECT_NE(doc.find("`" + std::string(c.channel) + "`"), std::string::npos) << c.channel << " undocumented";
+    EXPECT_NE(doc.find("`" + std::string(c.channel) + "`"), std::string::npos)
+        << c.channel << " undocumented";
   }
   for (const auto& [name, s] : LcmSchema::semx().structs()) {
     EXPECT_NE(doc.find("**`" + s.name + "`**"), std::string::npos) << s.name << " undocumented";

@@ -23,7 +23,8 @@ inline int test_port(int offset) { return 20000 + (static_cast<int>(getpid()) % 
 // A child process with its stdout+stderr captured to a file.
 class Process {
  public:
-  Process(const std::vector<std::string>& argv, const std::string& log_file, const std::string& lcm_url = "") {
+  Process(const std::vector<std::string>& argv, const std::string& log_file,
+          const std::string& lcm_url = "") {
     pid_ = fork();
     if (pid_ == 0) {
       setpgid(0, 0);

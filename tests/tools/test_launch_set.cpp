@@ -70,9 +70,10 @@ TEST(LaunchSet, ErrorsNameTheProblem) {
   EXPECT_NE(error_of("name: x\nprocesses:\n  - name: a\n    command: [run]\n    comand: [x]\n")
                 .find("unknown key 'processes[0].comand'"),
             std::string::npos);
-  EXPECT_NE(error_of("name: x\nprocesses:\n  - name: a\n    command: [run]\n  - name: a\n    command: [run]\n")
-                .find("defined twice"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("name: x\nprocesses:\n  - name: a\n    command: [run]\n  - name: a\n    command: [run]\n")
+          .find("defined twice"),
+      std::string::npos);
   EXPECT_NE(error_of("name: x\nprocesses: []\n").find("at least one process"), std::string::npos);
   EXPECT_NE(error_of("name: x\nprocesses:\n  - name: a\n").find("command"), std::string::npos);
 }

@@ -20,7 +20,9 @@ using namespace semx::testing;
 
 namespace {
 
-std::string temp_path(const std::string& name) { return ::testing::TempDir() + "/semx_" + std::to_string(getpid()) + "_" + name; }
+std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "/semx_" + std::to_string(getpid()) + "_" + name;
+}
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
@@ -45,20 +47,25 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
   const std::string log = temp_path("lockstep.lcmlog");
   const std::string set = temp_path("lockstep.yaml");
   constexpr int kTicks = 200;
-  std::ofstream(set) << "name: lockstep-test\nprocesses:\n"
-                        "  - name: logger\n    command: [lcm-logger, --quiet, --force, \"" << log << "\"]\n"
-                        "    required: false\n"
-                        "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
-                        "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
-                        "--ticks, \"" << kTicks << "\"]\n    ends_set: true\n    start_delay: 1.0\n";
+  std::ofstream(set)
+      << "name: lockstep-test\nprocesses:\n"
+         "  - name: logger\n    command: [lcm-logger, --quiet, --force, \""
+      << log
+      << "\"]\n"
+         "    required: false\n"
+         "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+         "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
+         "--ticks, \""
+      << kTicks << "\"]\n    ends_set: true\n    start_delay: 1.0\n";
   const std::string out = temp_path("lockstep.out");
   Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--grace", "3"}, out);
   ASSERT_EQ(launcher.wait(30), 0) << read_file(out);
-  for (pid_t pid : started_pids(read_file(out))) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " left behind";
+  for (pid_t pid : started_pids(read_file(out)))
+    EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " left behind";
 
   lcm::LogFile file(log, "r");
   ASSERT_TRUE(file.good()) << log;
-  std::vector<int64_t> ticks;           // new ticks, in log order
+  std::vector<int64_t> ticks;            // new ticks, in log order
   std::map<int64_t, std::size_t> acked;  // tick -> position of the monitor's first ack
   std::set<std::string> status_nodes;
   std::size_t position = 0;
@@ -129,17 +136,19 @@ TEST(Processes, LauncherKilledHardTakesItsChildrenWithIt) {
 
 TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
   const std::string set = temp_path("fail.yaml");
-  std::ofstream(set) << "name: fail-test\nprocesses:\n"
-                        "  - name: flaky\n    command: [/bin/sh, -c, \"echo partial-line-no-newline; exit 3\"]\n"
-                        "    restart: on-failure\n    max_restarts: 2\n    restart_delay: 0.1\n"
-                        "  - name: sleeper\n    command: [/bin/sleep, \"60\"]\n";
+  std::ofstream(set)
+      << "name: fail-test\nprocesses:\n"
+         "  - name: flaky\n    command: [/bin/sh, -c, \"echo partial-line-no-newline; exit 3\"]\n"
+         "    restart: on-failure\n    max_restarts: 2\n    restart_delay: 0.1\n"
+         "  - name: sleeper\n    command: [/bin/sleep, \"60\"]\n";
   const std::string out = temp_path("fail.out");
   Process launcher({bin("semx-launch"), set, "--no-color"}, out);
   EXPECT_EQ(launcher.wait(20), 1);
   const std::string text = read_file(out);
   EXPECT_NE(text.find("restart 2/2"), std::string::npos) << text;
   EXPECT_NE(text.find("required process failed"), std::string::npos) << text;
-  EXPECT_NE(text.find("flaky   | partial-line-no-newline"), std::string::npos) << "output is prefixed:\n" << text;
+  EXPECT_NE(text.find("flaky   | partial-line-no-newline"), std::string::npos) << "output is prefixed:\n"
+                                                                               << text;
   for (pid_t pid : started_pids(text)) EXPECT_FALSE(pid_alive(pid));
 }
 
@@ -185,12 +194,12 @@ TEST(Processes, NodeSurvivesHostileMessagesWithBoundedMemory) {
   const int64_t rss_before = watch.last.rss_kb;
 
   // 5 kinds x 40 messages that can never be well-formed, then noise and bit flips.
-  Process hostile({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000", "--kinds",
-                   "truncated,oversized,negative-length,huge-length,wrong-fingerprint"},
+  Process hostile({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000",
+                   "--kinds", "truncated,oversized,negative-length,huge-length,wrong-fingerprint"},
                   temp_path("hostile.out"), url);
   ASSERT_EQ(hostile.wait(20), 0);
-  Process noise({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000", "--kinds",
-                 "random-bytes,bit-flip", "--seed", "9"},
+  Process noise({bin("semx-hostile"), "--channel", "NODE_STATUS", "--count", "40", "--rate", "2000",
+                 "--kinds", "random-bytes,bit-flip", "--seed", "9"},
                 temp_path("noise.out"), url);
   ASSERT_EQ(noise.wait(20), 0);
   listen(1.0);
@@ -215,9 +224,11 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   semx::runtime::Node node(o);
 
   // ./semx record, fed 50 clock messages, stopped with Ctrl-C.
-  Process recorder({"/bin/bash", semx_cmd, "record", "--out", log, "--lcm-url", url, "--channels", "SIM_CLOCK"},
-                   temp_path("record.out"));
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // dependency check, then lcm-logger subscribes
+  Process recorder(
+      {"/bin/bash", semx_cmd, "record", "--out", log, "--lcm-url", url, "--channels", "SIM_CLOCK"},
+      temp_path("record.out"));
+  std::this_thread::sleep_for(
+      std::chrono::milliseconds(2500));  // dependency check, then lcm-logger subscribes
   for (int i = 0; i < 50; ++i) {
     semx::clock_t c{};
     c.tick = i;
@@ -242,7 +253,8 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   node.subscribe<semx::clock_t>("SIM_CLOCK", [&](const semx::clock_t& c) { ticks.push_back(c.tick); });
   node.drain();
   ticks.clear();
-  Process player({"/bin/bash", semx_cmd, "replay", log, "--speed", "4", "--lcm-url", url}, temp_path("replay.out"));
+  Process player({"/bin/bash", semx_cmd, "replay", log, "--speed", "4", "--lcm-url", url},
+                 temp_path("replay.out"));
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(15);
   while (ticks.size() < 50 && std::chrono::steady_clock::now() < end) node.spin_once(50);
   EXPECT_EQ(player.wait(10), 0) << read_file(temp_path("replay.out"));

@@ -37,18 +37,21 @@ int main(int argc, char** argv) {
     std::string mode = "realtime", nodes;
     double period_ms = 10, speed = 1, resend_s = 0.5, stall_warn_s = 5;
     int64_t ticks = -1;
-    ArgParser p("semx-clock", "Publishes SIM_CLOCK. LOCKSTEP advances only when every --lockstep-nodes node acked.");
+    ArgParser p("semx-clock",
+                "Publishes SIM_CLOCK. LOCKSTEP advances only when every --lockstep-nodes node acked.");
     flags.add_to(p);
     p.option("mode", "realtime|lockstep", "clock mode (default realtime)", &mode)
         .option("period-ms", "MS", "simulated milliseconds per tick (default 10)", &period_ms)
         .option("speed", "X", "REALTIME: simulated seconds per wall second (default 1)", &speed)
         .option("lockstep-nodes", "A,B", "LOCKSTEP: nodes that must ack every tick", &nodes)
         .option("ticks", "N", "exit after N ticks (default: run until stopped)", &ticks)
-        .option("resend", "S", "LOCKSTEP: resend an unacked tick after S wall seconds (default 0.5)", &resend_s)
+        .option("resend", "S", "LOCKSTEP: resend an unacked tick after S wall seconds (default 0.5)",
+                &resend_s)
         .option("stall-warn", "S", "LOCKSTEP: report nodes that keep the clock waiting longer (default 5)",
                 &stall_warn_s);
     if (!p.parse(argc, argv)) return 0;
-    if (mode != "realtime" && mode != "lockstep") throw ArgError("--mode: '" + mode + "' is not realtime or lockstep");
+    if (mode != "realtime" && mode != "lockstep")
+      throw ArgError("--mode: '" + mode + "' is not realtime or lockstep");
     if (!(period_ms > 0)) throw ArgError("--period-ms must be positive");
     if (!(speed > 0)) throw ArgError("--speed must be positive");
 
@@ -72,7 +75,8 @@ int main(int argc, char** argv) {
                                 [&](const semx::ack_t& a) { server.on_ack(a.node, a.tick); });
     node.set_state(NodeState::kRunning, mode);
     std::cout << "semx-clock: " << mode << ", " << period_ms << " ms/tick"
-              << (cfg.mode == ClockMode::kLockstep ? ", waiting for " + nodes : "") << " on " << node.url() << "\n";
+              << (cfg.mode == ClockMode::kLockstep ? ", waiting for " + nodes : "") << " on " << node.url()
+              << "\n";
 
     bool warned = false;
     while (!node.stopped() && !server.finished()) {
@@ -103,8 +107,8 @@ int main(int argc, char** argv) {
     node.drain();
     node.set_state(server.finished() ? NodeState::kDone : NodeState::kStopping,
                    "tick " + std::to_string(server.current_tick()));
-    std::cout << "semx-clock: stopped at tick " << server.current_tick() << " (t = " << server.current_utime() * 1e-6
-              << " s)\n";
+    std::cout << "semx-clock: stopped at tick " << server.current_tick()
+              << " (t = " << server.current_utime() * 1e-6 << " s)\n";
     return 0;
   });
 }

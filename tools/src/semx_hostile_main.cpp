@@ -23,8 +23,10 @@ int main(int argc, char** argv) {
     flags.add_to(p);
     p.option("channel", "NAME", "channel to attack (required)", &channel)
         .option("type", "TYPE", "type to corrupt (default: the channel's type, e.g. semx.path_t)", &type_name)
-        .option("kinds", "K1,K2", "truncated, oversized, negative-length, huge-length, wrong-fingerprint, "
-                                  "random-bytes, bit-flip, or all (default)", &kinds)
+        .option("kinds", "K1,K2",
+                "truncated, oversized, negative-length, huge-length, wrong-fingerprint, "
+                "random-bytes, bit-flip, or all (default)",
+                &kinds)
         .option("count", "N", "messages per kind (default 10)", &count)
         .option("rate", "HZ", "messages per second (default 200)", &rate)
         .option("seed", "N", "random seed (default 1)", &seed);
@@ -63,8 +65,8 @@ int main(int argc, char** argv) {
         std::this_thread::sleep_for(period);
       }
     }
-    std::cout << "semx-hostile: sent " << sent << " malformed " << type->full_name() << " messages on " << channel
-              << "\n";
+    std::cout << "semx-hostile: sent " << sent << " malformed " << type->full_name() << " messages on "
+              << channel << "\n";
     return 0;
   });
 }

@@ -37,9 +37,10 @@ int main(int argc, char** argv) {
     std::vector<std::string> arg_list;
     double duration = 0, grace = 5;
     bool list = false, no_color = false;
-    ArgParser p("semx-launch",
-                "Starts a process set and supervises it: output prefixed by process name, restarts as the set\n"
-                "says, Ctrl-C stops everything. SET is a file or a name in tools/launch/ (without .yaml).");
+    ArgParser p(
+        "semx-launch",
+        "Starts a process set and supervises it: output prefixed by process name, restarts as the set\n"
+        "says, Ctrl-C stops everything. SET is a file or a name in tools/launch/ (without .yaml).");
     p.positional("SET", "the process set", &set_name)
         .repeated("arg", "NAME=VALUE", "set one of the set's args (see --list)", &arg_list)
         .option("lcm-url", "URL", "LCM provider for every process (exported as LCM_DEFAULT_URL)", &lcm_url)

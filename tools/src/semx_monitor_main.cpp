@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
     flags.add_to(p);
     p.option("interval", "S", "seconds between reports (default 1)", &interval)
         .option("expect", "A,B", "exit 0 as soon as these nodes report and are not stopping/failed", &expect)
-        .option("timeout", "S", "with --expect: exit 1 if they have not all reported after S seconds", &timeout)
+        .option("timeout", "S", "with --expect: exit 1 if they have not all reported after S seconds",
+                &timeout)
         .option("duration", "S", "exit 0 after S seconds", &duration)
         .flag("channels", "also show messages, rate, bandwidth and malformed count per channel", &channels)
         .flag("once", "print one report (after --interval) and exit", &once);
@@ -47,15 +48,17 @@ int main(int argc, char** argv) {
     Node node(flags.options());
     install_shutdown_handlers();
     semx::tools::StatusBoard board;
-    node.subscribe<semx::node_status_t>(semx::channels::NODE_STATUS,
-                                        [&](const semx::node_status_t& s) { board.on_status(s, wall_seconds()); });
+    node.subscribe<semx::node_status_t>(semx::channels::NODE_STATUS, [&](const semx::node_status_t& s) {
+      board.on_status(s, wall_seconds());
+    });
     if (channels) {
       // Validate every known channel's bytes as they pass, independent of any subscriber.
       const auto& schema = LcmSchema::semx();
       node.subscribe_raw(".*", [&](const std::string& channel, const uint8_t* data, std::size_t size) {
         const auto type_name = semx::channels::type_of(channel);
         const LcmStruct* type = type_name.empty() ? nullptr : schema.find(type_name);
-        const bool bad = type && validate_wire(schema, *type, schema.fingerprint(*type), data, size) != WireError::kNone;
+        const bool bad =
+            type && validate_wire(schema, *type, schema.fingerprint(*type), data, size) != WireError::kNone;
         board.on_message(channel, size, bad);
       });
     }
@@ -75,8 +78,7 @@ int main(int argc, char** argv) {
         board.update_rates(now);
         char head[96];
         std::snprintf(head, sizeof head, "--- %zu nodes, %.1f s ---\n", board.nodes().size(), now - start);
-        std::cout << head
-                  << board.render_nodes(now);
+        std::cout << head << board.render_nodes(now);
         if (channels) std::cout << board.render_channels();
         std::cout.flush();
         next_report = now + interval;

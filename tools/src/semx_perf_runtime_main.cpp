@@ -44,8 +44,8 @@ int main(int argc, char** argv) {
     volatile int sink = 0;
 
     const double validate = per_second(reps, [&](int) {
-      sink = sink + static_cast<int>(validate_wire(schema, depth_type, semx::depth_image_t::getHash(), bytes.data(),
-                                                   bytes.size()));
+      sink = sink + static_cast<int>(validate_wire(schema, depth_type, semx::depth_image_t::getHash(),
+                                                   bytes.data(), bytes.size()));
     });
     const double decode = per_second(reps / 4, [&](int) {
       semx::depth_image_t m;
@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
     }
     const double reject = per_second(reps * 10, [&](int i) {
       const auto& h = hostile[static_cast<std::size_t>(i) % hostile.size()];
-      sink = sink + static_cast<int>(validate_wire(schema, path_type, schema.fingerprint(path_type), h.data(), h.size()));
+      sink = sink + static_cast<int>(
+                        validate_wire(schema, path_type, schema.fingerprint(path_type), h.data(), h.size()));
     });
     std::printf("hostile_roadmap_checks: %.0f messages/s\n", reject);
 

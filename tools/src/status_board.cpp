@@ -56,8 +56,8 @@ std::vector<std::string> StatusBoard::missing(const std::vector<std::string>& na
 std::string StatusBoard::render_nodes(double wall_s) const {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-16s %7s %-9s %9s %9s %9s %6s %6s %6s %7s %5s  %s\n", "NODE", "PID", "STATE",
-                "SIM_T[s]", "RECV", "SENT", "DROP", "BAD", "CPU%", "RSS[MB]", "AGE", "DETAIL");
+  std::snprintf(line, sizeof line, "%-16s %7s %-9s %9s %9s %9s %6s %6s %6s %7s %5s  %s\n", "NODE", "PID",
+                "STATE", "SIM_T[s]", "RECV", "SENT", "DROP", "BAD", "CPU%", "RSS[MB]", "AGE", "DETAIL");
   out += line;
   for (const auto& [name, row] : nodes_) {
     const auto& s = row.status;
@@ -78,7 +78,8 @@ std::string StatusBoard::render_channels() const {
   out += line;
   for (const auto& [name, row] : channels_) {
     std::snprintf(line, sizeof line, "%-20s %10lld %8.1f %10.1f %8lld\n", name.c_str(),
-                  static_cast<long long>(row.messages), row.hz, row.kbps, static_cast<long long>(row.malformed));
+                  static_cast<long long>(row.messages), row.hz, row.kbps,
+                  static_cast<long long>(row.malformed));
     out += line;
   }
   return out;

@@ -230,7 +230,8 @@ class Supervisor {
       for (ssize_t i = 0; i < k; ++i) {
         if (sig[i] == SIGINT || sig[i] == SIGTERM) {
           if (!stopping_) {
-            say(std::string("caught ") + (sig[i] == SIGINT ? "SIGINT" : "SIGTERM") + ": stopping all processes");
+            say(std::string("caught ") + (sig[i] == SIGINT ? "SIGINT" : "SIGTERM") +
+                ": stopping all processes");
             begin_stop(130);
           } else if (!killed_) {
             say("second signal: SIGKILL now");
@@ -254,14 +255,16 @@ class Supervisor {
         c.pid = -1;
         flush(c);
         const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        const std::string how = WIFEXITED(status) ? "exited with " + std::to_string(code)
-                                                  : std::string("killed by signal ") + strsignal(WTERMSIG(status));
+        const std::string how = WIFEXITED(status)
+                                    ? "exited with " + std::to_string(code)
+                                    : std::string("killed by signal ") + strsignal(WTERMSIG(status));
         const ExitAction action = on_process_exit(*c.spec, code, c.restarts, stopping_);
         switch (action) {
           case ExitAction::kRestart:
             ++c.restarts;
-            say(c, how + ": restart " + std::to_string(c.restarts) + "/" + std::to_string(c.spec->max_restarts) +
-                       " in " + std::to_string(c.spec->restart_delay_s) + " s");
+            say(c, how + ": restart " + std::to_string(c.restarts) + "/" +
+                       std::to_string(c.spec->max_restarts) + " in " +
+                       std::to_string(c.spec->restart_delay_s) + " s");
             c.pending = true;
             c.start_at = now_s() + c.spec->restart_delay_s;
             break;
@@ -315,7 +318,8 @@ class Supervisor {
 
 int run_launch_set(const LaunchSet& set, const SupervisorOptions& options) {
   if (g_signal_pipe[0] < 0) {
-    if (pipe2(g_signal_pipe, O_CLOEXEC | O_NONBLOCK) != 0) throw std::runtime_error("cannot create signal pipe");
+    if (pipe2(g_signal_pipe, O_CLOEXEC | O_NONBLOCK) != 0)
+      throw std::runtime_error("cannot create signal pipe");
   }
   struct sigaction sa {};
   sa.sa_handler = on_supervisor_signal;

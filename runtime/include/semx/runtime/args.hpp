@@ -22,15 +22,19 @@ class ArgParser {
   // A flag taking a value; `value_name` shows in help ("--world FILE").
   ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help,
                     std::string* out);
-  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help, double* out);
-  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help, int64_t* out);
-  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help, int* out);
+  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help,
+                    double* out);
+  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help,
+                    int64_t* out);
+  ArgParser& option(const std::string& name, const std::string& value_name, const std::string& help,
+                    int* out);
   // A flag that may be given several times.
   ArgParser& repeated(const std::string& name, const std::string& value_name, const std::string& help,
                       std::vector<std::string>* out);
   ArgParser& flag(const std::string& name, const std::string& help, bool* out);
   // Positional arguments, in order; `required` ones must be present.
-  ArgParser& positional(const std::string& name, const std::string& help, std::string* out, bool required = true);
+  ArgParser& positional(const std::string& name, const std::string& help, std::string* out,
+                        bool required = true);
 
   // Parses argv. Returns false when --help was given (help already printed to stdout).
   // Throws ArgError naming the offending flag for unknown flags, missing or malformed values.

@@ -6,26 +6,26 @@
 #include <string_view>
 
 // X(CHANNEL, type) for every channel, in data-flow order.
-#define SEMX_CHANNELS(X)                  \
-  X(SIM_CLOCK, clock_t)                   \
-  X(SIM_ACK, ack_t)                       \
-  X(SIM_EVENT, sim_event_t)               \
-  X(ODOMETRY, odometry_t)                 \
-  X(IMU, imu_t)                           \
-  X(CAMERA_DEPTH, depth_image_t)          \
-  X(CAMERA_RGB, rgb_image_t)              \
-  X(CAMERA_LABELS, label_image_t)         \
-  X(CONTROL_CMD, control_cmd_t)           \
-  X(MAP_UPDATE, map_update_t)             \
-  X(MAP_SNAPSHOT, map_snapshot_t)         \
-  X(MAP_REQUEST, map_request_t)           \
-  X(MAP_STATS, map_stats_t)               \
-  X(ESDF_LOCAL, esdf_local_t)             \
-  X(SEMANTIC_REGIONS, semantic_regions_t) \
-  X(ROADMAP, roadmap_t)                   \
-  X(PLAN_PATH, path_t)                    \
-  X(PLANNER_STATUS, planner_status_t)     \
-  X(TRAJECTORY, trajectory_t)             \
+#define SEMX_CHANNELS(X)                    \
+  X(SIM_CLOCK, clock_t)                     \
+  X(SIM_ACK, ack_t)                         \
+  X(SIM_EVENT, sim_event_t)                 \
+  X(ODOMETRY, odometry_t)                   \
+  X(IMU, imu_t)                             \
+  X(CAMERA_DEPTH, depth_image_t)            \
+  X(CAMERA_RGB, rgb_image_t)                \
+  X(CAMERA_LABELS, label_image_t)           \
+  X(CONTROL_CMD, control_cmd_t)             \
+  X(MAP_UPDATE, map_update_t)               \
+  X(MAP_SNAPSHOT, map_snapshot_t)           \
+  X(MAP_REQUEST, map_request_t)             \
+  X(MAP_STATS, map_stats_t)                 \
+  X(ESDF_LOCAL, esdf_local_t)               \
+  X(SEMANTIC_REGIONS, semantic_regions_t)   \
+  X(ROADMAP, roadmap_t)                     \
+  X(PLAN_PATH, path_t)                      \
+  X(PLANNER_STATUS, planner_status_t)       \
+  X(TRAJECTORY, trajectory_t)               \
   X(CONTROLLER_STATUS, controller_status_t) \
   X(NODE_STATUS, node_status_t)
 

@@ -19,8 +19,8 @@ namespace semx::runtime {
 
 struct ClockServerConfig {
   ClockMode mode = ClockMode::kRealtime;
-  int64_t period_us = 10000;  // 100 Hz: the odometry rate
-  double speed = 1.0;         // REALTIME only
+  int64_t period_us = 10000;                // 100 Hz: the odometry rate
+  double speed = 1.0;                       // REALTIME only
   std::vector<std::string> lockstep_nodes;  // LOCKSTEP: who must ack every tick
   double resend_after_s = 0.5;
   int64_t max_ticks = -1;  // stop after this many ticks (-1: never)
@@ -41,7 +41,7 @@ class ClockServer {
   // Records an ack; returns true if it completed the current tick's set.
   bool on_ack(const std::string& node, int64_t tick);
 
-  bool finished() const;              // max_ticks reached (and acked, in LOCKSTEP)
+  bool finished() const;  // max_ticks reached (and acked, in LOCKSTEP)
   int64_t current_tick() const { return tick_; }
   int64_t current_utime() const { return tick_ < 0 ? 0 : tick_ * config_.period_us; }
   std::vector<std::string> waiting_for() const;  // LOCKSTEP: nodes that have not acked yet

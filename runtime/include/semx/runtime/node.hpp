@@ -34,12 +34,12 @@ class NodeError : public std::runtime_error {
 
 struct NodeOptions {
   std::string name;
-  std::string lcm_url;              // empty: resolve_lcm_url("")
-  bool lockstep = false;            // ack every SIM_CLOCK tick (a registered lockstep node)
-  bool follow_clock = true;         // subscribe to SIM_CLOCK (off for the clock's source)
-  double status_period_s = 1.0;     // NODE_STATUS heartbeat, wall clock
+  std::string lcm_url;                        // empty: resolve_lcm_url("")
+  bool lockstep = false;                      // ack every SIM_CLOCK tick (a registered lockstep node)
+  bool follow_clock = true;                   // subscribe to SIM_CLOCK (off for the clock's source)
+  double status_period_s = 1.0;               // NODE_STATUS heartbeat, wall clock
   std::size_t max_message_bytes = 32u << 20;  // larger messages are dropped unread
-  bool quiet = false;               // no log lines for dropped messages
+  bool quiet = false;                         // no log lines for dropped messages
 };
 
 struct ChannelCounters {
@@ -58,7 +58,14 @@ struct NodeCounters {
   int64_t handler_errors = 0;
 };
 
-enum class NodeState : int8_t { kStarting = 0, kRunning = 1, kDegraded = 2, kDone = 3, kStopping = 4, kFailed = 5 };
+enum class NodeState : int8_t {
+  kStarting = 0,
+  kRunning = 1,
+  kDegraded = 2,
+  kDone = 3,
+  kStopping = 4,
+  kFailed = 5
+};
 const char* to_string(NodeState s);
 
 // Set by SIGINT/SIGTERM once install_shutdown_handlers() ran.
@@ -90,7 +97,9 @@ class Node {
   bool publish_raw(const std::string& channel, const void* data, std::size_t size);
 
   // Called for each new SIM_CLOCK tick, before this node acks it in LOCKSTEP.
-  void on_tick(std::function<void(int64_t tick, int64_t utime)> fn) { tick_handlers_.push_back(std::move(fn)); }
+  void on_tick(std::function<void(int64_t tick, int64_t utime)> fn) {
+    tick_handlers_.push_back(std::move(fn));
+  }
   const SimClock& clock() const { return clock_; }
   int64_t now_utime() const { return clock_.now_utime(); }
   // For the clock's source, which does not follow SIM_CLOCK: its own current time.

@@ -22,7 +22,8 @@ struct NodeFlags {
     p.option("name", "NAME", "node name in NODE_STATUS and SIM_ACK (default: " + name + ")", &name)
         .option("lcm-url", "URL", "LCM provider (default: $LCM_DEFAULT_URL, else loopback udpm)", &lcm_url)
         .flag("lockstep", "ack every SIM_CLOCK tick: the clock waits for this node", &lockstep)
-        .option("status-period", "S", "NODE_STATUS heartbeat period in wall seconds (default 1)", &status_period_s)
+        .option("status-period", "S", "NODE_STATUS heartbeat period in wall seconds (default 1)",
+                &status_period_s)
         .flag("quiet", "do not log dropped or malformed messages", &quiet);
   }
 

@@ -14,8 +14,8 @@
 namespace semx::runtime {
 
 // Depth pixels are 16-bit millimetres with two reserved values.
-constexpr uint16_t kDepthInvalid = 0;          // no measurement: ignore the pixel
-constexpr uint16_t kDepthNoReturn = 0xFFFF;    // nothing within max range: free up to max range
+constexpr uint16_t kDepthInvalid = 0;        // no measurement: ignore the pixel
+constexpr uint16_t kDepthNoReturn = 0xFFFF;  // nothing within max range: free up to max range
 constexpr uint16_t kDepthMaxEncodable = 0xFFFE;
 
 struct PinholeCamera {

@@ -64,7 +64,9 @@ inline constexpr std::array<SemanticClassInfo, static_cast<size_t>(SemanticClass
     {SemanticClass::kWindow, "window", {120, 190, 230}, true},
 }};
 
-inline const SemanticClassInfo& class_info(SemanticClass c) { return kSemanticClasses[static_cast<size_t>(c)]; }
+inline const SemanticClassInfo& class_info(SemanticClass c) {
+  return kSemanticClasses[static_cast<size_t>(c)];
+}
 
 inline std::optional<SemanticClass> class_from_name(std::string_view name) {
   for (const auto& info : kSemanticClasses) {

@@ -23,8 +23,8 @@ enum class HostileKind {
   kNegativeLength,  // an array length field set below zero
   kHugeLength,      // an array length field set to INT32_MAX (or the largest of its type)
   kWrongFingerprint,
-  kRandomBytes,     // noise of random size
-  kBitFlip,         // a valid message with random bits flipped
+  kRandomBytes,  // noise of random size
+  kBitFlip,      // a valid message with random bits flipped
 };
 const char* to_string(HostileKind k);
 std::vector<HostileKind> all_hostile_kinds();

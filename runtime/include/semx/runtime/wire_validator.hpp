@@ -15,20 +15,20 @@ namespace semx::runtime {
 
 enum class WireError {
   kNone,
-  kTooShort,            // fewer bytes than the fixed fields need
-  kFingerprint,         // not the expected type (or a different version of it)
-  kNegativeLength,      // an array length field below zero
-  kLengthExceedsBuffer, // an array that cannot fit in the bytes left
-  kBadString,           // string length < 1, past the end, or not NUL-terminated
-  kTrailingBytes,       // bytes left after the last field
-  kTooDeep,             // nesting deeper than any semx type
+  kTooShort,             // fewer bytes than the fixed fields need
+  kFingerprint,          // not the expected type (or a different version of it)
+  kNegativeLength,       // an array length field below zero
+  kLengthExceedsBuffer,  // an array that cannot fit in the bytes left
+  kBadString,            // string length < 1, past the end, or not NUL-terminated
+  kTrailingBytes,        // bytes left after the last field
+  kTooDeep,              // nesting deeper than any semx type
 };
 
 const char* to_string(WireError e);
 
 // Checks `data[0, size)` as an encoded `type` whose fingerprint must equal `fingerprint`
 // (pass the generated T::getHash()).
-WireError validate_wire(const LcmSchema& schema, const LcmStruct& type, int64_t fingerprint, const uint8_t* data,
-                        std::size_t size);
+WireError validate_wire(const LcmSchema& schema, const LcmStruct& type, int64_t fingerprint,
+                        const uint8_t* data, std::size_t size);
 
 }  // namespace semx::runtime

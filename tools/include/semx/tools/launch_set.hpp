@@ -16,8 +16,8 @@ struct ProcessSpec {
   RestartPolicy restart = RestartPolicy::kNever;
   int max_restarts = 3;
   double restart_delay_s = 1.0;
-  bool required = true;    // its failure (after restarts) fails the whole set
-  bool ends_set = false;   // its successful exit ends the whole set (e.g. the clock after N ticks)
+  bool required = true;      // its failure (after restarts) fails the whole set
+  bool ends_set = false;     // its successful exit ends the whole set (e.g. the clock after N ticks)
   double start_delay_s = 0;  // wall seconds after the set starts
   std::map<std::string, std::string> env;
 };

@@ -15,7 +15,7 @@ class StatusBoard {
  public:
   struct NodeRow {
     semx::node_status_t status;
-    double last_seen_s = 0;   // wall seconds
+    double last_seen_s = 0;  // wall seconds
     double prev_cpu_s = 0;
     double prev_seen_s = -1;
     double cpu_percent = 0;

@@ -12,11 +12,11 @@
 namespace semx::tools {
 
 struct SupervisorOptions {
-  std::string bin_dir;       // where semx executables live (command[0] without '/' is looked up here first)
-  std::string root_dir;      // relative command paths resolve against it
-  std::string lcm_url;       // exported as LCM_DEFAULT_URL to every process, if not empty
-  double duration_s = 0;     // stop the set after this many wall seconds (0: never)
-  double grace_s = 5.0;      // SIGINT -> SIGKILL
+  std::string bin_dir;    // where semx executables live (command[0] without '/' is looked up here first)
+  std::string root_dir;   // relative command paths resolve against it
+  std::string lcm_url;    // exported as LCM_DEFAULT_URL to every process, if not empty
+  double duration_s = 0;  // stop the set after this many wall seconds (0: never)
+  double grace_s = 5.0;   // SIGINT -> SIGKILL
   bool color = false;
 };
 
