@@ -74,11 +74,6 @@ bool primitive_of(const std::string& t, LcmPrimitive& p) {
   return false;
 }
 
-bool is_integer(LcmPrimitive p) {
-  return p == LcmPrimitive::kInt8 || p == LcmPrimitive::kInt16 || p == LcmPrimitive::kInt32 ||
-         p == LcmPrimitive::kInt64;
-}
-
 // lcm-gen's hash (lcmgen.c): a rolling 64-bit hash of member names, primitive type names and
 // dimensions. The arithmetic right shift and char truncation are part of the definition.
 int64_t hash_update(int64_t v, char c) {
@@ -201,6 +196,11 @@ class Parser {
 };
 
 }  // namespace
+
+bool is_integer(LcmPrimitive p) {
+  return p == LcmPrimitive::kInt8 || p == LcmPrimitive::kInt16 || p == LcmPrimitive::kInt32 ||
+         p == LcmPrimitive::kInt64;
+}
 
 std::size_t primitive_size(LcmPrimitive p) {
   switch (p) {

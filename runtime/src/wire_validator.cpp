@@ -75,8 +75,7 @@ class Walker {
         const std::size_t each = primitive_size(f.kind);
         if (count > left / each)
           return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
-        if (f.dims.empty() && (f.kind == LcmPrimitive::kInt8 || f.kind == LcmPrimitive::kInt16 ||
-                               f.kind == LcmPrimitive::kInt32 || f.kind == LcmPrimitive::kInt64)) {
+        if (f.dims.empty() && is_integer(f.kind)) {
           ints[fi] = read_int(each);
         } else {
           pos_ += static_cast<std::size_t>(count) * each;

@@ -70,5 +70,6 @@ class LcmSchema {
 };
 
 std::size_t primitive_size(LcmPrimitive p);  // 0 for strings and structs
+bool is_integer(LcmPrimitive p);             // the kinds an array size may have
 
 }  // namespace semx::runtime
