@@ -1,0 +1,128 @@
+#include "semx/simulator/simulator.hpp"
+
+#include <cmath>
+
+#include "semx/simulator/random.hpp"
+
+namespace semx::simulator {
+namespace {
+
+// Independent random streams drawn from the one seed.
+enum Stream : uint64_t { kImuStream = 1, kDepthStream = 2, kDetectionStream = 3 };
+
+void load_camera(runtime::ConfigMap& m, runtime::PinholeCamera& c) {
+  m.get("width", c.width, 1, 8192);
+  m.get("height", c.height, 1, 8192);
+  // A principal point not given follows the image size, so changing only the size stays sane.
+  c.cx = 0.5 * c.width;
+  c.cy = 0.5 * c.height;
+  m.get("fx", c.fx, 1.0, 1e5);
+  m.get("fy", c.fy, 1.0, 1e5);
+  m.get("cx", c.cx, -1e5, 1e5);
+  m.get("cy", c.cy, -1e5, 1e5);
+  m.get("min_range", c.min_range, 0.0, 60.0);
+  m.get("max_range", c.max_range, 0.01, 65.0);
+  if (c.max_range <= c.min_range) m.fail("max_range", "must exceed min_range");
+}
+
+}  // namespace
+
+void load(runtime::ConfigMap& m, SimulatorConfig& c) {
+  // At most 10 ms: at 1.5 m/s the body then moves 1.5 cm a step and cannot skip through a 10 cm wall.
+  m.get("step_us", c.step_us, int64_t{10}, int64_t{10000});
+  int64_t seed = static_cast<int64_t>(c.seed);
+  m.get("seed", seed);
+  c.seed = static_cast<uint64_t>(seed);
+  m.get("camera_rate_hz", c.camera_rate_hz, 0.1, 1000.0);
+  m.get("odometry_rate_hz", c.odometry_rate_hz, 0.1, 10000.0);
+  m.get("command_timeout_us", c.command_timeout_us, int64_t{0}, int64_t{3600000000});
+  m.get("cylinder_segments", c.cylinder_segments, 3, 1024);
+  auto cam = m.child("camera");
+  load_camera(cam, c.camera);
+  auto veh = m.child("vehicle");
+  load(veh, c.vehicle);
+  auto imu = m.child("imu");
+  load(imu, c.imu);
+  auto dn = m.child("depth_noise");
+  load(dn, c.depth_noise);
+  auto det = m.child("detection_noise");
+  load(det, c.detection_noise);
+}
+
+Simulator::Simulator(World world, const SimulatorConfig& config)
+    : world_(std::make_unique<World>(std::move(world))),
+      config_(config),
+      imu_(config.imu, mix_seed(config.seed, kImuStream)) {
+  vehicle_ = std::make_unique<Quadrotor>(*world_, config_.vehicle);
+  RasterizerOptions ro;
+  ro.mesh.cylinder_segments = config_.cylinder_segments;
+  rasterizer_ = std::make_unique<Rasterizer>(*world_, ro);
+}
+
+CommandResult Simulator::command(const ControlCommand& cmd) {
+  CommandResult r = vehicle_->command(cmd);
+  if (r.accepted) {
+    last_command_us_ = time_us_;
+    timed_out_ = false;
+  }
+  return r;
+}
+
+int64_t Simulator::due_time(int64_t k, double rate_hz) const {
+  return static_cast<int64_t>(std::llround(static_cast<double>(k) * 1e6 / rate_hz));
+}
+
+StepResult Simulator::step() {
+  StepResult r;
+  time_us_ += config_.step_us;
+  r.utime = time_us_;
+  if (config_.command_timeout_us > 0 && !timed_out_ &&
+      vehicle_->active_command().mode != ControlCommand::kHold &&
+      time_us_ - last_command_us_ > config_.command_timeout_us) {
+    vehicle_->hold();
+    timed_out_ = true;
+    ++timeouts_;
+    r.command_timed_out = true;
+  }
+  const StepReport rep = vehicle_->step(config_.step_us * 1e-6);
+  if (rep.collision_start) {
+    r.collision = CollisionEvent{time_us_, vehicle_->state().position, rep.solid, vehicle_->collisions()};
+  }
+  // One sample per step at most: a step longer than a sensor's period decimates it.
+  auto due = [&](int64_t& count, double rate) {
+    if (time_us_ < due_time(count + 1, rate)) return false;
+    while (time_us_ >= due_time(count + 1, rate)) ++count;
+    return true;
+  };
+  if (due(imu_count_, config_.imu.rate_hz)) r.imu = imu_.sample(time_us_, vehicle_->state());
+  if (due(odom_count_, config_.odometry_rate_hz)) r.odometry = odometry();
+  r.camera_due = due(camera_count_, config_.camera_rate_hz);
+  return r;
+}
+
+OdometrySample Simulator::odometry() const {
+  const VehicleState& s = vehicle_->state();
+  OdometrySample o;
+  o.utime = time_us_;
+  o.position = s.position;
+  o.orientation = s.orientation();
+  o.velocity = s.velocity;
+  o.angular_velocity = {0, 0, s.yaw_rate};
+  return o;
+}
+
+void Simulator::render_camera(CameraFrame& out, unsigned channels) {
+  rasterizer_->render(config_.camera, vehicle_->state().camera_pose(), channels, out);
+  out.utime = time_us_;
+  out.frame_id = camera_count_;
+  const uint64_t id = static_cast<uint64_t>(camera_count_);
+  if (channels & kRenderDepth) {
+    apply_depth_noise(out.depth, config_.depth_noise, mix_seed(mix_seed(config_.seed, kDepthStream), id));
+  }
+  if (channels & kRenderLabels) {
+    apply_detection_noise(out, config_.detection_noise,
+                          mix_seed(mix_seed(config_.seed, kDetectionStream), id));
+  }
+}
+
+}  // namespace semx::simulator
