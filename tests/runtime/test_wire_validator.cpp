@@ -126,3 +126,20 @@ TEST(WireValidator, RejectsBadStrings) {
   no_nul[16 + 4 + 6] = 'x';
   EXPECT_EQ(validate_wire(schema, type, h, no_nul.data(), no_nul.size()), WireError::kBadString);
 }
+
+TEST(GeneratedCode, InlinedDecodeOfDoublesIsReadBack) {
+  // lcm_coretypes.h writes doubles through int64_t*; without -fno-strict-aliasing GCC -O2 may
+  // read the double from before the decode. This is the pattern every handler uses.
+  semx::odometry_t in{};
+  in.utime = 5;
+  in.position[0] = 2.0;
+  in.position[1] = 3.0;
+  in.velocity[2] = -1.5;
+  std::vector<uint8_t> b(static_cast<std::size_t>(in.getEncodedSize()));
+  in.encode(b.data(), 0, static_cast<int>(b.size()));
+  semx::odometry_t out{};
+  ASSERT_EQ(out.decode(b.data(), 0, static_cast<int>(b.size())), static_cast<int>(b.size()));
+  EXPECT_EQ(out.position[0], 2.0);
+  EXPECT_EQ(out.position[1], 3.0);
+  EXPECT_EQ(out.velocity[2], -1.5);
+}

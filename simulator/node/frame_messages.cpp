@@ -1,0 +1,155 @@
+#include "frame_messages.hpp"
+
+#include <zlib.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace semx::simulator {
+
+namespace {
+
+void put_vec(double out[3], const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) out[i] = v[i];
+}
+
+// Little-endian bytes of a uint16 image (the wire format whatever the host).
+std::vector<uint8_t> le_bytes(const std::vector<uint16_t>& a) {
+  std::vector<uint8_t> out(a.size() * 2);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    out[2 * i] = static_cast<uint8_t>(a[i] & 0xFF);
+    out[2 * i + 1] = static_cast<uint8_t>(a[i] >> 8);
+  }
+  return out;
+}
+
+std::vector<uint8_t> maybe_compress(std::vector<uint8_t> raw, bool compress, int8_t& mode) {
+  mode = 0;
+  if (!compress) return raw;
+  uLongf size = compressBound(raw.size());
+  std::vector<uint8_t> out(size);
+  if (compress2(out.data(), &size, raw.data(), raw.size(), 1) != Z_OK) return raw;
+  out.resize(size);
+  mode = 1;
+  return out;
+}
+
+}  // namespace
+
+semx::odometry_t to_message(const OdometrySample& s) {
+  semx::odometry_t m{};
+  m.utime = s.utime;
+  put_vec(m.position, s.position);
+  m.orientation[0] = s.orientation.w();
+  m.orientation[1] = s.orientation.x();
+  m.orientation[2] = s.orientation.y();
+  m.orientation[3] = s.orientation.z();
+  put_vec(m.velocity, s.velocity);
+  put_vec(m.angular_velocity, s.angular_velocity);
+  return m;
+}
+
+semx::imu_t to_message(const ImuSample& s) {
+  semx::imu_t m{};
+  m.utime = s.utime;
+  put_vec(m.linear_acceleration, s.linear_acceleration);
+  put_vec(m.angular_velocity, s.angular_velocity);
+  return m;
+}
+
+semx::camera_info_t camera_info(const CameraFrame& f) {
+  semx::camera_info_t info{};
+  info.frame_id = f.frame_id;
+  put_vec(info.sensor_position, f.pose.translation());
+  const Eigen::Quaterniond q(f.pose.linear());
+  info.sensor_orientation[0] = q.w();
+  info.sensor_orientation[1] = q.x();
+  info.sensor_orientation[2] = q.y();
+  info.sensor_orientation[3] = q.z();
+  info.width = f.camera.width;
+  info.height = f.camera.height;
+  info.fx = f.camera.fx;
+  info.fy = f.camera.fy;
+  info.cx = f.camera.cx;
+  info.cy = f.camera.cy;
+  info.min_range = f.camera.min_range;
+  info.max_range = f.camera.max_range;
+  return info;
+}
+
+semx::depth_image_t depth_message(const CameraFrame& f, bool compress) {
+  semx::depth_image_t m{};
+  m.utime = f.utime;
+  m.info = camera_info(f);
+  m.depth_data = maybe_compress(le_bytes(f.depth.data), compress, m.compression);
+  m.num_depth_bytes = static_cast<int32_t>(m.depth_data.size());
+  return m;
+}
+
+semx::rgb_image_t rgb_message(const CameraFrame& f, bool compress) {
+  semx::rgb_image_t m{};
+  m.utime = f.utime;
+  m.info = camera_info(f);
+  std::vector<uint8_t> raw(f.rgb.data.size() * 3);
+  for (std::size_t i = 0; i < f.rgb.data.size(); ++i) {
+    raw[3 * i] = f.rgb.data[i].r;
+    raw[3 * i + 1] = f.rgb.data[i].g;
+    raw[3 * i + 2] = f.rgb.data[i].b;
+  }
+  m.rgb_data = maybe_compress(std::move(raw), compress, m.rgb_compression);
+  m.num_rgb_bytes = static_cast<int32_t>(m.rgb_data.size());
+  return m;
+}
+
+semx::label_image_t label_message(const CameraFrame& f, bool compress) {
+  semx::label_image_t m{};
+  m.utime = f.utime;
+  m.info = camera_info(f);
+  const std::size_t n = f.class_label.data.size();
+  std::vector<uint8_t> raw(n * 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    const uint16_t c = f.class_label.data[i], k = f.instance_label.data[i];
+    raw[4 * i] = static_cast<uint8_t>(c & 0xFF);
+    raw[4 * i + 1] = static_cast<uint8_t>(c >> 8);
+    raw[4 * i + 2] = static_cast<uint8_t>(k & 0xFF);
+    raw[4 * i + 3] = static_cast<uint8_t>(k >> 8);
+  }
+  m.label_data = maybe_compress(std::move(raw), compress, m.label_compression);
+  m.num_label_bytes = static_cast<int32_t>(m.label_data.size());
+  return m;
+}
+
+bool well_formed(const semx::control_cmd_t& m) {
+  if (m.mode < semx::control_cmd_t::HOLD || m.mode > semx::control_cmd_t::ACCELERATION) return false;
+  if (m.yaw_mode != semx::control_cmd_t::YAW_ANGLE && m.yaw_mode != semx::control_cmd_t::YAW_RATE) return false;
+  for (double v : m.setpoint) {
+    if (!std::isfinite(v)) return false;
+  }
+  return std::isfinite(m.yaw) && std::isfinite(m.yaw_rate);
+}
+
+ControlCommand from_message(const semx::control_cmd_t& m) {
+  ControlCommand c;
+  c.mode = m.mode;
+  c.setpoint = Eigen::Vector3d(m.setpoint[0], m.setpoint[1], m.setpoint[2]);
+  c.yaw_mode = m.yaw_mode;
+  c.yaw = m.yaw;
+  c.yaw_rate = m.yaw_rate;
+  return c;
+}
+
+bool image_bytes(int8_t compression, const std::vector<uint8_t>& payload, std::size_t expected_bytes,
+                 std::vector<uint8_t>& out) {
+  if (compression == 0) {
+    if (payload.size() != expected_bytes) return false;
+    out = payload;
+    return true;
+  }
+  if (compression != 1) return false;
+  out.resize(expected_bytes);
+  uLongf size = expected_bytes;
+  if (uncompress(out.data(), &size, payload.data(), payload.size()) != Z_OK) return false;
+  return size == expected_bytes;
+}
+
+}  // namespace semx::simulator

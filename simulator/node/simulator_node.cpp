@@ -1,0 +1,133 @@
+#include "simulator_node.hpp"
+
+#include <semx/clock_t.hpp>
+#include <semx/sim_event_t.hpp>
+
+#include <chrono>
+#include <cstdio>
+
+#include "frame_messages.hpp"
+#include "semx/runtime/channels.hpp"
+
+namespace semx::simulator {
+
+namespace ch = semx::channels;
+
+namespace {
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeOptions options)
+    : sim_(sim), node_(node), options_(std::move(options)), server_(options_.clock) {
+  node_.subscribe<semx::control_cmd_t>(
+      ch::CONTROL_CMD, [this](const semx::control_cmd_t& m) { on_command(m); }, &well_formed);
+  next_progress_s_ = options_.progress_every_s;
+}
+
+void SimulatorNode::on_command(const semx::control_cmd_t& m) {
+  const CommandResult r = sim_.command(from_message(m));
+  if (!r.accepted) {
+    ++rejected_;
+    publish_event(semx::sim_event_t::COMMAND_REJECTED, r.reason, sim_.odometry().position, -1, rejected_);
+  }
+}
+
+void SimulatorNode::publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid,
+                                  int64_t count) {
+  semx::sim_event_t e{};
+  e.utime = sim_.time_us();
+  e.type = type;
+  e.description = text;
+  for (int i = 0; i < 3; ++i) e.position[i] = where[i];
+  e.solid_index = solid;
+  e.count = count;
+  node_.publish(ch::SIM_EVENT, e);
+}
+
+void SimulatorNode::publish_frame() {
+  sim_.render_camera(frame_, options_.render_channels);
+  if (frame_.channels & kRenderDepth) node_.publish(ch::CAMERA_DEPTH, depth_message(frame_, options_.compress));
+  if (frame_.channels & kRenderRgb) node_.publish(ch::CAMERA_RGB, rgb_message(frame_, options_.compress));
+  if (frame_.channels & kRenderLabels) node_.publish(ch::CAMERA_LABELS, label_message(frame_, options_.compress));
+  ++frames_;
+}
+
+void SimulatorNode::advance_to(int64_t utime) {
+  if (!started_) {
+    // Tick 0 carries the initial state, so the map starts from the first view, not 33 ms later.
+    started_ = true;
+    publish_event(semx::sim_event_t::EPISODE_START, sim_.world().name, sim_.odometry().position, -1, 1);
+    node_.publish(ch::ODOMETRY, to_message(sim_.odometry()));
+    publish_frame();
+  }
+  while (sim_.time_us() < utime) {
+    const StepResult r = sim_.step();
+    if (r.imu) node_.publish(ch::IMU, to_message(*r.imu));
+    if (r.odometry) node_.publish(ch::ODOMETRY, to_message(*r.odometry));
+    if (r.collision) {
+      publish_event(semx::sim_event_t::COLLISION, "body box hit a solid", r.collision->position, r.collision->solid,
+                    r.collision->count);
+    }
+    if (r.camera_due) publish_frame();
+  }
+}
+
+void SimulatorNode::publish_clock(const runtime::ClockTick& t) {
+  semx::clock_t c{};
+  c.utime = t.utime;
+  c.tick = t.tick;
+  c.mode = static_cast<int8_t>(options_.clock.mode);
+  c.speed = options_.clock.mode == runtime::ClockMode::kRealtime ? options_.clock.speed : 0.0;
+  c.period_us = options_.clock.period_us;
+  node_.set_time(t.utime, t.tick);
+  node_.publish(ch::SIM_CLOCK, c);
+}
+
+bool SimulatorNode::poll(double wall_s) {
+  if (wall_start_ < 0) wall_start_ = wall_s;
+  node_.drain();
+  if (server_.finished()) return false;
+  if (auto t = server_.poll(wall_s)) {
+    if (!t->resend) advance_to(t->utime);
+    publish_clock(*t);
+    const double sim_s = static_cast<double>(t->utime) * 1e-6;
+    if (options_.progress_every_s > 0 && sim_s >= next_progress_s_) {
+      const auto o = sim_.odometry();
+      std::printf("semx-simulator: t=%.1f s  pos=(%.2f, %.2f, %.2f)  frames=%lld  collisions=%lld  %.1fx real time\n",
+                  sim_s, o.position.x(), o.position.y(), o.position.z(), static_cast<long long>(frames_),
+                  static_cast<long long>(sim_.vehicle().collisions()),
+                  sim_s / std::max(1e-9, wall_s - wall_start_));
+      next_progress_s_ += options_.progress_every_s;
+    }
+  }
+  return !server_.finished();
+}
+
+int SimulatorNode::run() {
+  node_.set_state(runtime::NodeState::kRunning, sim_.world().name);
+  const bool lockstep = options_.clock.mode == runtime::ClockMode::kLockstep;
+  while (!node_.stopped()) {
+    const double now = wall_seconds();
+    if (!poll(now)) break;
+    // Lockstep with acks to wait for, or realtime between ticks: sleep in LCM until something
+    // arrives (an ack, a command) or 1 ms passes. Lockstep with nobody to wait for: no sleep.
+    if (!lockstep || !options_.clock.lockstep_nodes.empty()) {
+      if (node_.spin_once(1) < 0) return 1;
+    }
+  }
+  const double wall = wall_seconds() - wall_start_;
+  const double sim_s = static_cast<double>(sim_.time_us()) * 1e-6;
+  if (server_.finished()) {
+    publish_event(semx::sim_event_t::EPISODE_END, "time limit", sim_.odometry().position, -1, 1);
+    node_.set_state(runtime::NodeState::kDone, "episode ended");
+  }
+  std::printf("semx-simulator: simulated %.2f s in %.2f s wall (%.1fx real time), %lld frames, %lld collisions, "
+              "%lld commands rejected\n",
+              sim_s, wall, sim_s / std::max(1e-9, wall), static_cast<long long>(frames_),
+              static_cast<long long>(sim_.vehicle().collisions()), static_cast<long long>(rejected_));
+  return 0;
+}
+
+}  // namespace semx::simulator

@@ -1,0 +1,59 @@
+// The simulator process: drives the Simulator library from the clock and publishes its sensors
+// over LCM (DESIGN.md §1, §3). Each tick it steps physics up to the tick's time, publishes every
+// sensor sample that fell due (IMU, odometry, camera frames, events), and only then SIM_CLOCK, so
+// a node that handled SIM_CLOCK(k) has seen all data up to k. In LOCKSTEP the next tick waits for
+// the registered nodes' acks; with none registered the simulation runs as fast as it can.
+#pragma once
+
+#include <semx/control_cmd_t.hpp>
+
+#include <cstdint>
+#include <string>
+
+#include "semx/runtime/clock_server.hpp"
+#include "semx/runtime/node.hpp"
+#include "semx/simulator/simulator.hpp"
+
+namespace semx::simulator {
+
+struct SimulatorNodeOptions {
+  runtime::ClockServerConfig clock;  // period_us is the tick; max_ticks ends the episode
+  bool compress = false;             // zlib the image payloads
+  unsigned render_channels = kRenderAll;
+  double progress_every_s = 10.0;    // simulated seconds between progress lines (0: none)
+};
+
+class SimulatorNode {
+ public:
+  SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeOptions options);
+
+  // Runs until the episode ends (max_ticks) or shutdown; returns the exit code.
+  int run();
+  // One pass of the loop at wall time `wall_s`: handles commands, publishes a tick if one is due.
+  // Returns false once the episode is over.
+  bool poll(double wall_s);
+
+  int64_t ticks() const { return server_.current_tick() + 1; }
+  int64_t frames_published() const { return frames_; }
+  int64_t commands_rejected() const { return rejected_; }
+
+ private:
+  void advance_to(int64_t utime);
+  void publish_frame();
+  void publish_clock(const runtime::ClockTick& t);
+  void publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid, int64_t count);
+  void on_command(const semx::control_cmd_t& m);
+
+  Simulator& sim_;
+  runtime::Node& node_;
+  SimulatorNodeOptions options_;
+  runtime::ClockServer server_;
+  CameraFrame frame_;
+  bool started_ = false;
+  int64_t frames_ = 0;
+  int64_t rejected_ = 0;
+  double next_progress_s_ = 0;
+  double wall_start_ = -1;
+};
+
+}  // namespace semx::simulator

@@ -1,0 +1,184 @@
+// The simulator process's node over memq://: what it publishes, in which order, and how it
+// treats commands, good and bad.
+#include <gtest/gtest.h>
+#include <semx/camera_info_t.hpp>
+#include <semx/clock_t.hpp>
+#include <semx/control_cmd_t.hpp>
+#include <semx/depth_image_t.hpp>
+#include <semx/label_image_t.hpp>
+#include <semx/odometry_t.hpp>
+#include <semx/sim_event_t.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "frame_messages.hpp"
+#include "semx/runtime/channels.hpp"
+#include "simulator_node.hpp"
+#include "test_util.hpp"
+
+using namespace semx;
+using namespace semx::simulator;
+
+namespace {
+
+struct Captured {
+  std::vector<std::string> channels;
+  std::vector<std::vector<uint8_t>> payloads;
+};
+
+runtime::NodeOptions memq_node() {
+  runtime::NodeOptions o;
+  o.name = "simulator";
+  o.lcm_url = "memq://";
+  o.follow_clock = false;
+  o.quiet = true;
+  o.status_period_s = 1e6;
+  return o;
+}
+
+SimulatorNodeOptions lockstep(int64_t ticks) {
+  SimulatorNodeOptions o;
+  o.clock.mode = runtime::ClockMode::kLockstep;
+  o.clock.max_ticks = ticks;
+  o.progress_every_s = 0;
+  return o;
+}
+
+// Runs `ticks` lockstep ticks of env1 and captures every message, in publish order.
+Captured run(int64_t ticks, const std::function<void(runtime::Node&, int64_t tick)>& before_tick = nullptr) {
+  SimulatorConfig cfg;
+  cfg.depth_noise.enabled = true;  // noise must be seeded too
+  Simulator sim(test::shipped("env1"), cfg);
+  runtime::Node node(memq_node());
+  Captured c;
+  node.subscribe_raw(".*", [&](const std::string& ch, const uint8_t* d, std::size_t n) {
+    c.channels.push_back(ch);
+    c.payloads.emplace_back(d, d + n);
+  });
+  SimulatorNode sn(sim, node, lockstep(ticks));
+  double wall = 0;
+  int64_t tick = 0;
+  while (true) {
+    if (before_tick) before_tick(node, tick);
+    if (!sn.poll(wall += 0.001)) break;
+    node.drain();
+    ++tick;
+  }
+  node.drain();
+  return c;
+}
+
+}  // namespace
+
+TEST(SimulatorNode, PublishesSensorsBeforeEachTickAtTheirRates) {
+  const Captured c = run(101);  // ticks 0..100: one simulated second
+  int odometry = 0, imu = 0, depth = 0, labels = 0, rgb = 0, clock = 0;
+  int64_t last_tick = -1;
+  for (std::size_t i = 0; i < c.channels.size(); ++i) {
+    const auto& ch = c.channels[i];
+    odometry += ch == "ODOMETRY";
+    imu += ch == "IMU";
+    depth += ch == "CAMERA_DEPTH";
+    labels += ch == "CAMERA_LABELS";
+    rgb += ch == "CAMERA_RGB";
+    if (ch == "SIM_CLOCK") {
+      semx::clock_t m;
+      ASSERT_EQ(m.decode(c.payloads[i].data(), 0, static_cast<int>(c.payloads[i].size())),
+                static_cast<int>(c.payloads[i].size()));
+      EXPECT_EQ(m.tick, last_tick + 1);
+      EXPECT_EQ(m.utime, m.tick * 10000);
+      last_tick = m.tick;
+      ++clock;
+    }
+  }
+  EXPECT_EQ(clock, 101);
+  EXPECT_EQ(odometry, 101) << "100 Hz plus the initial state";
+  EXPECT_NEAR(imu, 200, 1);
+  EXPECT_EQ(depth, 31) << "30 Hz plus the initial view";
+  EXPECT_EQ(depth, labels);
+  EXPECT_EQ(depth, rgb);
+  EXPECT_EQ(c.channels.back(), "SIM_CLOCK") << "a tick's data comes before its SIM_CLOCK";
+}
+
+TEST(SimulatorNode, FramesCarryTheirPoseAndDecodeToTheRenderedImage) {
+  const Captured c = run(4);
+  for (std::size_t i = 0; i < c.channels.size(); ++i) {
+    if (c.channels[i] != "CAMERA_DEPTH") continue;
+    semx::depth_image_t m;
+    ASSERT_GT(m.decode(c.payloads[i].data(), 0, static_cast<int>(c.payloads[i].size())), 0);
+    EXPECT_EQ(m.info.width, 640);
+    EXPECT_EQ(m.info.height, 480);
+    EXPECT_EQ(m.info.fx, 320.0);
+    const auto start = test::shipped("env1").start;
+    EXPECT_NEAR(m.info.sensor_position[0], start.position.x(), 1e-9);
+    std::vector<uint8_t> raw;
+    ASSERT_TRUE(image_bytes(m.compression, m.depth_data, 640u * 480u * 2u, raw));
+    int valid = 0;
+    for (std::size_t k = 0; k < raw.size(); k += 2) valid += (raw[k] | raw[k + 1] << 8) != 0;
+    EXPECT_GT(valid, 640 * 480 / 2) << "most pixels see something in env1";
+    return;
+  }
+  FAIL() << "no depth frame";
+}
+
+TEST(SimulatorNode, CompressedImagesRoundTrip) {
+  SimulatorConfig cfg;
+  Simulator sim(test::shipped("env1"), cfg);
+  CameraFrame f;
+  sim.render_camera(f);
+  for (bool compress : {false, true}) {
+    const auto d = depth_message(f, compress);
+    std::vector<uint8_t> raw;
+    ASSERT_TRUE(image_bytes(d.compression, d.depth_data, f.depth.data.size() * 2, raw));
+    for (std::size_t k = 0; k < f.depth.data.size(); ++k) {
+      ASSERT_EQ(static_cast<uint16_t>(raw[2 * k] | raw[2 * k + 1] << 8), f.depth.data[k]);
+    }
+    const auto l = label_message(f, compress);
+    ASSERT_TRUE(image_bytes(l.label_compression, l.label_data, f.class_label.data.size() * 4, raw));
+    EXPECT_EQ(raw[0] | raw[1] << 8, f.class_label.data[0]);
+    if (compress) {
+      EXPECT_LT(l.label_data.size(), f.class_label.data.size()) << "labels compress well";
+    }
+  }
+  std::vector<uint8_t> out;
+  EXPECT_FALSE(image_bytes(1, std::vector<uint8_t>{1, 2, 3}, 100, out));
+  EXPECT_FALSE(image_bytes(0, std::vector<uint8_t>{1, 2, 3}, 100, out));
+}
+
+TEST(SimulatorNode, VelocityCommandsMoveTheVehicleAndBadOnesAreDropped) {
+  double first_x = 0, last_x = 0;
+  bool have_first = false;
+  int64_t malformed = 0;
+  const Captured c = run(101, [&](runtime::Node& node, int64_t tick) {
+    semx::control_cmd_t cmd{};
+    cmd.utime = tick * 10000;
+    cmd.mode = semx::control_cmd_t::VELOCITY;
+    cmd.setpoint[0] = 0.3;
+    cmd.yaw_mode = semx::control_cmd_t::YAW_RATE;
+    if (tick % 10 == 5) cmd.setpoint[1] = std::nan("");  // must be dropped, not obeyed
+    node.publish("CONTROL_CMD", cmd);
+    malformed = node.counters().malformed;
+  });
+  for (std::size_t i = 0; i < c.channels.size(); ++i) {
+    if (c.channels[i] != "ODOMETRY") continue;
+    semx::odometry_t m{};
+    ASSERT_GT(m.decode(c.payloads[i].data(), 0, static_cast<int>(c.payloads[i].size())), 0);
+    if (!have_first) first_x = m.position[0];
+    have_first = true;
+    last_x = m.position[0];
+    EXPECT_TRUE(std::isfinite(m.position[1]));
+  }
+  EXPECT_GT(last_x - first_x, 0.15) << "0.3 m/s for a second with a first-order response";
+  EXPECT_GE(malformed, 9) << "NaN commands are counted as malformed";
+}
+
+TEST(SimulatorNode, SameSeedSameMessageStream) {
+  const Captured a = run(40), b = run(40);
+  ASSERT_EQ(a.channels, b.channels);
+  for (std::size_t i = 0; i < a.payloads.size(); ++i) {
+    if (a.channels[i] == "NODE_STATUS") continue;  // wall-clock liveness fields
+    EXPECT_EQ(a.payloads[i], b.payloads[i]) << a.channels[i] << " #" << i;
+  }
+}
