@@ -1,6 +1,9 @@
 // semx-perf-sim: the simulator's speed figures, one "name: value unit" line each.
 //   semx-perf-sim [--world WORLD] [--frames N] [--seconds S]
 // Single-threaded throughout, so every figure is for one core.
+#include <unistd.h>
+
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +43,30 @@ std::vector<Eigen::Isometry3d> sample_poses(const sim::World& w, int n, uint64_t
     poses.push_back(s.camera_pose());
   }
   return poses;
+}
+
+// The whole simulator process in LOCKSTEP with no registered node, over loopback udpm on a port
+// of its own: the figure the issue asks for (rendering, encoding and publishing every frame).
+double process_realtime_factor(const std::string& world, double seconds, bool rgb) {
+  char exe[4096];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0) return -1;
+  exe[n] = '\0';
+  const std::string dir = std::string(exe).substr(0, std::string(exe).rfind('/'));
+  const std::string url = "udpm://239.255.76.67:" + std::to_string(23000 + getpid() % 1000) +
+                          "?ttl=0&recv_buf_size=4194304";
+  const std::string cmd = "'" + dir + "/semx-simulator' --world " + world + " --clock lockstep --duration " +
+                          std::to_string(seconds) + " --progress 0 --quiet --lcm-url '" + url + "'" +
+                          (rgb ? "" : " --no-rgb") + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return -1;
+  char line[1024];
+  double factor = -1;
+  while (std::fgets(line, sizeof line, p)) {
+    const char* at = std::strstr(line, "s wall (");
+    if (at) factor = std::strtod(at + 8, nullptr);
+  }
+  return pclose(p) == 0 ? factor : -1;
 }
 
 void print(const char* name, double value, const char* unit) {
@@ -146,6 +173,8 @@ int main(int argc, char** argv) {
     const auto [rtf, rendered] = run(true);
     print("sim_step_render_realtime_factor", rtf, "x");
     print("sim_camera_frames_rendered", static_cast<double>(rendered), "frames");
+    print("lockstep_process_realtime_factor", process_realtime_factor(world_name, sim_seconds, true), "x");
+    print("lockstep_process_no_rgb_realtime_factor", process_realtime_factor(world_name, sim_seconds, false), "x");
   } catch (const std::exception& e) {
     std::cerr << "semx-perf-sim: " << e.what() << "\n";
     return 1;
