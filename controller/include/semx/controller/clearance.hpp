@@ -1,0 +1,41 @@
+// The dense clearance check every trajectory passes before it is flown, and that each new ESDF
+// re-runs on the part about to be flown.
+//
+// Samples are at most `spacing` apart along the curve, so every point of the curve lies within
+// spacing/2 of a sample, where the field is at most lipschitz·spacing/2 lower: a sample passes
+// only if its distance minus that pad meets the bound. So the bound holds on the whole curve,
+// not only at the samples.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "semx/controller/distance_field.hpp"
+#include "semx/controller/trajectory.hpp"
+
+namespace semx::controller {
+
+struct ClearanceRule {
+  double bound = 0.4;          // m, required distance
+  double hard_bound = 0.3;     // m, never below this, even when escaping
+  double spacing = 0.02;       // m of arc length between samples
+  bool allow_escape = true;    // a start below `bound` may climb out without getting closer
+  double escape_slack = 0.01;  // m, how much closer than its start an escape may wobble
+  bool require_exit = true;    // an escape must reach the bound before t1 (off for a horizon)
+};
+
+struct ClearanceReport {
+  bool ok = true;
+  bool escaping = false;         // started below the bound
+  double min_distance = 1e300;   // smallest sampled distance, m
+  double min_time = 0.0;         // when (s since the trajectory's start)
+  double violation_time = -1.0;  // first sample breaking the rule, s; < 0 when none
+  Eigen::Vector3d violation_point = Eigen::Vector3d::Zero();
+  double violation_distance = 0.0;
+  int samples = 0;
+};
+
+// Checks trajectory times [t0, t1] (clamped to the trajectory) against `field`.
+ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceField& field, double t0,
+                                double t1, const ClearanceRule& rule);
+
+}  // namespace semx::controller

@@ -1,0 +1,85 @@
+// Every parameter of the controller, with its default. This struct is the one place defaults are
+// set; docs/controller.md and controller/config/controller.yaml mirror it (a test loads the YAML
+// file and compares it with these defaults).
+//
+// YAML layout: top-level rates, then one mapping per struct below (limits, clearance,
+// trajectory, optimizer, path, tracking, safety), keys named as the fields.
+#pragma once
+
+#include "semx/runtime/config.hpp"
+
+namespace semx::controller {
+
+// Dynamic limits every output trajectory respects at every instant (Euclidean norms).
+struct LimitsConfig {
+  double max_velocity = 1.0;      // m/s; a path's max_speed may lower it, never raise it
+  double max_acceleration = 2.0;  // m/s²
+  double max_yaw_rate = 1.0;      // rad/s
+};
+
+struct ClearanceConfig {
+  double half_size = 0.3;       // m, vehicle radius: ESDF distance below this is a collision
+  double margin = 0.1;          // m, a new trajectory keeps ESDF distance >= half_size + margin
+  double brake_margin = 0.05;   // m, a flown trajectory brakes when it would come below half_size
+                                // + brake_margin (smaller than margin: no brake on map jitter)
+  double check_spacing = 0.02;  // m, arc length between dense clearance samples
+  // A trajectory that starts below the bound (the vehicle already is) may climb out of it
+  // without getting closer than its start; otherwise such a vehicle could never move again.
+  bool allow_escape = true;
+  // Space outside the ESDF window: free (max_distance) or an obstacle.
+  bool outside_is_obstacle = false;
+
+  double bound() const { return half_size + margin; }
+  double brake_bound() const { return half_size + brake_margin; }
+};
+
+struct TrajectoryConfig {
+  double knot_interval = 0.25;         // s, of the uniform cubic B-spline (before time scaling)
+  double fallback_speed_factor = 0.5;  // fallback cruise speed as a fraction of max_velocity
+};
+
+struct OptimizerConfig {
+  int max_iterations = 200;         // L-BFGS iterations; 0 disables it (always the fallback)
+  double weight_smoothness = 1.0;   // on squared jerk differences of the control points (m²)
+  double weight_clearance = 40.0;   // on squared distance below the clearance target (m²)
+  double weight_feasibility = 1.0;  // on squared relative excess of velocity/acceleration
+  double target_margin = 0.1;       // m, optimiser's target distance = clearance bound + this
+  int samples_per_segment = 2;      // curve points per knot interval in the clearance cost
+};
+
+struct PathConfig {
+  int max_waypoints = 200;           // longer paths are rejected
+  double max_segment_length = 10.0;  // m, consecutive waypoints farther apart are rejected
+  double max_start_offset = 1.0;     // m, first waypoint farther from the vehicle is rejected
+  double max_age = 2.0;              // s, a path waiting longer for fresh inputs is rejected
+};
+
+struct TrackingConfig {
+  double position_gain = 2.0;      // 1/s, velocity command per metre of position error
+  double velocity_gain = 0.5;      // velocity command per m/s of velocity error
+  double accel_feedforward = 0.3;  // s, × reference acceleration: the vehicle's velocity lag
+  double yaw_feedforward = 0.5;    // s, × reference yaw rate: the vehicle's yaw-angle lag
+  double max_command_speed = 1.5;  // m/s, norm of any velocity command
+};
+
+struct SafetyConfig {
+  double check_horizon = 2.0;     // s of the flown trajectory checked against each new ESDF
+  double max_odometry_age = 0.2;  // s of message time; older odometry stops the vehicle
+  double max_esdf_age = 1.0;      // s of message time; an older ESDF stops the vehicle
+};
+
+struct ControllerConfig {
+  double rate_hz = 100.0;        // control steps per simulated second
+  double status_rate_hz = 10.0;  // CONTROLLER_STATUS period (besides every change)
+  LimitsConfig limits;
+  ClearanceConfig clearance;
+  TrajectoryConfig trajectory;
+  OptimizerConfig optimizer;
+  PathConfig path;
+  TrackingConfig tracking;
+  SafetyConfig safety;
+};
+
+void load(runtime::ConfigMap& m, ControllerConfig& c);
+
+}  // namespace semx::controller

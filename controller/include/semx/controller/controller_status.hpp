@@ -1,0 +1,41 @@
+// What the controller reports (CONTROLLER_STATUS as plain data) and counts.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace semx::controller {
+
+// Values match controller_status_t's constants.
+enum class ControllerState : int8_t {
+  kIdle = 0,        // nothing to fly (start-up, or inputs fresh again after a stop): hover
+  kTracking = 1,    // flying a trajectory
+  kBraking = 2,     // a new ESDF predicted a collision: trajectory dropped, hover, replan
+  kHolding = 3,     // the trajectory ended: holding its end point
+  kStaleInput = 4,  // odometry or ESDF too old (or missing): trajectory dropped, hover
+  kRejected = 5     // the last path was bad or had no safe trajectory: hover, replan
+};
+const char* to_string(ControllerState s);
+
+struct ControllerStatus {
+  int64_t plan_id = -1;  // the path the state refers to; -1 before the first
+  ControllerState state = ControllerState::kIdle;
+  std::string reason;
+  double tracking_error = 0.0;  // m, |p_ref - p| at this step
+  double tracking_rms = 0.0;    // m, over the current trajectory so far
+  double progress = 0.0;        // 0..1 of the current trajectory's duration
+};
+
+struct ControllerCounters {
+  int64_t paths = 0;         // PLAN_PATHs received
+  int64_t superseded = 0;    // replaced by a newer path before they were processed
+  int64_t rejected = 0;      // bad paths (empty, non-finite, jumps, too many, too old, too far)
+  int64_t unsafe = 0;        // paths for which neither trajectory passed the clearance check
+  int64_t trajectories = 0;  // trajectories started
+  int64_t optimized = 0;     // ... of which optimised
+  int64_t fallbacks = 0;     // ... of which the fallback
+  int64_t brakes = 0;        // predicted collisions
+  int64_t stale_stops = 0;   // entries into STALE_INPUT
+};
+
+}  // namespace semx::controller

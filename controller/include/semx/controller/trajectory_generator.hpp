@@ -1,0 +1,73 @@
+// From a path and the vehicle's state to a trajectory that is safe to fly, or a reason why there
+// is none.
+//
+//   1. time allocation along the polyline (time_allocation.hpp), control points sampled from it
+//      at the knot interval, the first three fixing the vehicle's position and velocity;
+//   2. ESDF optimisation (trajectory_optimizer.hpp);
+//   3. uniform time scaling so speed and acceleration are within the limits everywhere;
+//   4. the yaw profile (yaw_profile.hpp);
+//   5. the dense clearance check (clearance.hpp).
+// If 2 is disabled or failed, or 5 fails, the fallback (fallback.hpp: the polyline itself at
+// fallback_speed_factor × the speed limit) goes through 3-5 instead. If that fails too, there
+// is no trajectory: nothing that the ESDF says collides is ever returned.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "semx/controller/clearance.hpp"
+#include "semx/controller/controller_config.hpp"
+#include "semx/controller/distance_field.hpp"
+#include "semx/controller/trajectory.hpp"
+#include "semx/controller/trajectory_optimizer.hpp"
+
+namespace semx::controller {
+
+struct StartState {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  double yaw = 0.0;
+};
+
+struct GenerationResult {
+  bool ok = false;        // `trajectory` is safe to fly
+  Trajectory trajectory;  // plan_id, start_utime left to the caller
+  std::string reason;     // why the fallback was used, or why there is no trajectory
+  OptimizerReport optimizer;
+  ClearanceReport clearance;  // of the returned trajectory, or of the last one tried
+  double time_scale = 1.0;    // knot interval stretch applied for the limits
+};
+
+class TrajectoryGenerator {
+ public:
+  explicit TrajectoryGenerator(const ControllerConfig& config)
+      : config_(config), optimizer_(config.optimizer) {}
+
+  // `polyline[0]` is the start position; `yaws` are the unwrapped headings at each polyline
+  // point (yaws[0] = start.yaw). `max_speed` > 0 lowers the configured speed limit.
+  GenerationResult generate(const std::vector<Eigen::Vector3d>& polyline, const std::vector<double>& yaws,
+                            const StartState& start, double max_speed, const DistanceField& field) const;
+
+  // The rule a new trajectory must meet (bound = half_size + margin).
+  ClearanceRule generation_rule() const;
+  // The rule a flown trajectory is held to on each new ESDF (bound = half_size + brake_margin).
+  ClearanceRule flight_rule() const;
+
+  // Speed limit for a path asking for `max_speed` (0 = none).
+  double speed_limit(double max_speed) const;
+
+  // Step 1 alone: the optimiser's starting point (also what the perf tool times it from), and
+  // the times the polyline's points are passed on it.
+  PositionSpline initial_spline(const std::vector<Eigen::Vector3d>& polyline, const StartState& start,
+                                double v_max, std::vector<double>* point_times = nullptr) const;
+
+ private:
+  bool finish(Trajectory& trajectory, const std::vector<double>& times, const std::vector<double>& yaws,
+              double v_max, const DistanceField& field, GenerationResult& result) const;
+
+  ControllerConfig config_;
+  TrajectoryOptimizer optimizer_;
+};
+
+}  // namespace semx::controller

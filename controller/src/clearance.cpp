@@ -1,0 +1,66 @@
+#include "semx/controller/clearance.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace semx::controller {
+
+ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceField& field, double t0,
+                                double t1, const ClearanceRule& rule) {
+  ClearanceReport r;
+  if (trajectory.empty()) return r;
+  t0 = std::clamp(t0, 0.0, trajectory.duration());
+  t1 = std::clamp(t1, t0, trajectory.duration());
+  const double vmax = trajectory.max_speed();
+  const double span = t1 - t0;
+  const int n = vmax * span > 0 ? static_cast<int>(std::ceil(vmax * span / rule.spacing)) : 0;
+  const double pad = 0.5 * field.lipschitz() * rule.spacing;
+
+  const auto fail = [&](double t, const Eigen::Vector3d& p, double d) {
+    r.ok = false;
+    r.violation_time = t;
+    r.violation_point = p;
+    r.violation_distance = d;
+  };
+
+  double start = 0.0;
+  bool escaping = false;
+  for (int i = 0; i <= n; ++i) {
+    const double t = n == 0 ? t0 : t0 + span * i / n;
+    const Eigen::Vector3d p = trajectory.position_at(t);
+    const double d = field.distance(p);
+    ++r.samples;
+    if (d < r.min_distance) {
+      r.min_distance = d;
+      r.min_time = t;
+    }
+    const double low = d - pad;  // what the field may be anywhere near this sample
+    if (i == 0) {
+      start = d;
+      escaping = low < rule.bound;
+      r.escaping = escaping;
+      if (escaping && (!rule.allow_escape || low < rule.hard_bound)) {
+        fail(t, p, d);
+        return r;
+      }
+    }
+    if (escaping) {
+      if (low >= rule.bound) {
+        escaping = false;  // out: from here on the full bound applies
+      } else if (low < rule.hard_bound || d < start - rule.escape_slack) {
+        fail(t, p, d);
+        return r;
+      }
+    } else if (low < rule.bound) {
+      fail(t, p, d);
+      return r;
+    }
+  }
+  if (escaping && rule.require_exit) {
+    const Eigen::Vector3d end = trajectory.position_at(t1);
+    fail(t1, end, field.distance(end));
+  }
+  return r;
+}
+
+}  // namespace semx::controller

@@ -1,0 +1,70 @@
+#include "semx/controller/controller_node.hpp"
+
+#include <cmath>
+#include <memory>
+
+#include "semx/controller/message_adapter.hpp"
+#include "semx/runtime/channels.hpp"
+
+namespace semx::controller {
+
+ControllerNode::ControllerNode(runtime::NodeOptions options, const ControllerConfig& config)
+    : config_(config), node_(std::move(options)), controller_(config) {
+  node_.subscribe<semx::path_t>(
+      semx::channels::PLAN_PATH, [this](const semx::path_t& m) { controller_.on_path(to_path(m)); },
+      accept_path);
+  const OutsideWindow outside =
+      config_.clearance.outside_is_obstacle ? OutsideWindow::kObstacle : OutsideWindow::kFree;
+  node_.subscribe<semx::esdf_local_t>(
+      semx::channels::ESDF_LOCAL,
+      [this, outside](const semx::esdf_local_t& m) {
+        controller_.on_esdf(std::make_shared<GridDistanceField>(to_distance_field(m, outside)), m.utime);
+      },
+      accept_esdf);
+  node_.subscribe<semx::odometry_t>(
+      semx::channels::ODOMETRY,
+      [this](const semx::odometry_t& m) { controller_.on_odometry(to_vehicle_state(m)); }, accept_odometry);
+  node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  node_.set_state(runtime::NodeState::kRunning, "waiting for inputs");
+}
+
+void ControllerNode::on_tick(int64_t /*tick*/, int64_t utime) {
+  if (utime < last_step_utime_) {
+    // The clock restarted (a new episode): nothing from the old one applies.
+    controller_.reset();
+    last_step_utime_ = last_status_utime_ = -1;
+  }
+  // Run at rate_hz of simulation time whatever the clock's tick period (1 µs of slack for
+  // periods that do not divide evenly into microseconds).
+  const int64_t period = static_cast<int64_t>(std::llround(1e6 / config_.rate_hz));
+  if (last_step_utime_ >= 0 && utime - last_step_utime_ < period - 1) return;
+  last_step_utime_ = utime;
+
+  const StepOutput out = controller_.step(utime);
+  node_.publish(semx::channels::CONTROL_CMD, to_message(out.command, utime));
+  if (out.new_trajectory) node_.publish(semx::channels::TRAJECTORY, to_message(*out.new_trajectory, utime));
+  const int64_t status_period = static_cast<int64_t>(std::llround(1e6 / config_.status_rate_hz));
+  if (out.status_changed || last_status_utime_ < 0 || utime - last_status_utime_ >= status_period - 1) {
+    publish_status(out.status, utime);
+  }
+  if (out.status_changed) update_node_state();
+}
+
+void ControllerNode::publish_status(const ControllerStatus& s, int64_t utime) {
+  node_.publish(semx::channels::CONTROLLER_STATUS, to_message(s, utime));
+  last_status_utime_ = utime;
+}
+
+void ControllerNode::update_node_state() {
+  const ControllerStatus& s = controller_.status();
+  const ControllerCounters& c = controller_.counters();
+  const std::string detail = std::string(to_string(s.state)) + " plan " + std::to_string(s.plan_id) +
+                             "; trajectories " + std::to_string(c.trajectories) + " (fallback " +
+                             std::to_string(c.fallbacks) + "), rejected " +
+                             std::to_string(c.rejected + c.unsafe) + ", brakes " + std::to_string(c.brakes);
+  node_.set_state(
+      s.state == ControllerState::kStaleInput ? runtime::NodeState::kDegraded : runtime::NodeState::kRunning,
+      detail);
+}
+
+}  // namespace semx::controller

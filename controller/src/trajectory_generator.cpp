@@ -1,0 +1,127 @@
+#include "semx/controller/trajectory_generator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "semx/controller/fallback.hpp"
+#include "semx/controller/time_allocation.hpp"
+#include "semx/controller/yaw_profile.hpp"
+
+namespace semx::controller {
+namespace {
+
+std::string describe(const ClearanceReport& c) {
+  std::ostringstream s;
+  s.precision(3);
+  s << "distance " << c.violation_distance << " m at t = " << c.violation_time << " s ("
+    << c.violation_point.x() << ", " << c.violation_point.y() << ", " << c.violation_point.z() << ")";
+  return s.str();
+}
+
+}  // namespace
+
+double TrajectoryGenerator::speed_limit(double max_speed) const {
+  const double v = config_.limits.max_velocity;
+  return max_speed > 0 ? std::min(v, max_speed) : v;
+}
+
+ClearanceRule TrajectoryGenerator::generation_rule() const {
+  ClearanceRule r;
+  r.bound = config_.clearance.bound();
+  r.hard_bound = config_.clearance.half_size;
+  r.spacing = config_.clearance.check_spacing;
+  r.allow_escape = config_.clearance.allow_escape;
+  return r;
+}
+
+ClearanceRule TrajectoryGenerator::flight_rule() const {
+  ClearanceRule r = generation_rule();
+  r.bound = config_.clearance.brake_bound();
+  r.require_exit = false;  // a horizon may end before an escape does
+  return r;
+}
+
+bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<double>& times,
+                                 const std::vector<double>& yaws, double v_max, const DistanceField& field,
+                                 GenerationResult& result) const {
+  // The control-point bounds hold for the whole curve; stretching time by k divides speed by k
+  // and acceleration by k², leaving the (checked) geometry as it is.
+  double k = std::max({1.0, trajectory.max_speed() / v_max,
+                       std::sqrt(trajectory.max_acceleration() / config_.limits.max_acceleration)});
+  if (k > 1.0) k *= 1.0 + 1e-9;
+  result.time_scale = k;
+  trajectory.position.set_knot_interval(trajectory.knot_interval() * k);
+  std::vector<double> scaled(times);
+  for (double& t : scaled) t *= k;
+  add_yaw_profile(trajectory, scaled, yaws, config_.limits.max_yaw_rate);
+  result.clearance = check_clearance(trajectory, field, 0.0, trajectory.duration(), generation_rule());
+  return result.clearance.ok;
+}
+
+PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vector3d>& polyline,
+                                                   const StartState& start, double v_max,
+                                                   std::vector<double>* point_times) const {
+  const double dt = config_.trajectory.knot_interval;
+  Eigen::Vector3d v0 = start.velocity.allFinite() ? start.velocity : Eigen::Vector3d::Zero();
+  if (v0.norm() > v_max) v0 *= v_max / v0.norm();
+  const double along = polyline.size() > 1 ? v0.dot((polyline[1] - polyline[0]).normalized()) : 0.0;
+  const TimedPolyline timed(polyline, along, v_max, config_.limits.max_acceleration, dt);
+  if (point_times) *point_times = timed.point_times();
+  const int m = std::max(2, static_cast<int>(std::ceil(timed.duration() / dt)));
+  // Control point i sits near the curve at time (i-1)·dt. The first three give the start
+  // exactly: p(0) = Q1, v(0) = (Q2 - Q0)/2dt, a(0) = 0; the last three stop at the goal.
+  PositionSpline::Points q;
+  q.push_back(start.position - dt * v0);
+  q.push_back(start.position);
+  q.push_back(start.position + dt * v0);
+  for (int k = 2; k < m; ++k) q.push_back(timed.position(k * dt));
+  for (int k = 0; k < 3; ++k) q.push_back(polyline.back());
+  return PositionSpline(std::move(q), dt);
+}
+
+GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d>& polyline,
+                                               const std::vector<double>& yaws, const StartState& start,
+                                               double max_speed, const DistanceField& field) const {
+  GenerationResult result;
+  const double v_max = speed_limit(max_speed);
+  const double a_max = config_.limits.max_acceleration;
+  const double dt = config_.trajectory.knot_interval;
+
+  std::string why;
+  if (config_.optimizer.max_iterations > 0) {
+    std::vector<double> times;
+    Trajectory smooth;
+    smooth.optimized = true;
+    smooth.position = initial_spline(polyline, start, v_max, &times);
+    result.optimizer = optimizer_.optimize(smooth.position, field, v_max, a_max,
+                                           config_.clearance.bound() + config_.optimizer.target_margin);
+    if (result.optimizer.failed) {
+      why = "optimiser failed (" + result.optimizer.message + ")";
+    } else if (finish(smooth, times, yaws, v_max, field, result)) {
+      result.ok = true;
+      result.trajectory = std::move(smooth);
+      return result;
+    } else {
+      why = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
+    }
+  } else {
+    why = "optimiser disabled";
+  }
+
+  const double v_fallback = v_max * config_.trajectory.fallback_speed_factor;
+  FallbackSpline fb = make_fallback_spline(polyline, v_fallback, a_max, dt);
+  Trajectory safe;
+  safe.optimized = false;
+  safe.position = std::move(fb.spline);
+  if (finish(safe, fb.point_times, yaws, v_max, field, result)) {
+    result.ok = true;
+    result.trajectory = std::move(safe);
+    result.reason = "fallback: " + why;
+    return result;
+  }
+  result.reason = "no safe trajectory: " + why + "; the path itself: " + describe(result.clearance);
+  return result;
+}
+
+}  // namespace semx::controller

@@ -1,0 +1,59 @@
+// The controller's configuration: defaults, the documented YAML file, strictness.
+#include <gtest/gtest.h>
+
+#include "semx/controller/controller_config.hpp"
+
+using namespace semx::controller;
+using semx::runtime::ConfigError;
+using semx::runtime::load_config;
+
+TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
+  const ControllerConfig d;
+  const auto f =
+      load_config<ControllerConfig>(std::string(SEMX_SOURCE_DIR) + "/controller/config/controller.yaml");
+#define SAME(field) EXPECT_EQ(f.field, d.field) << #field
+  SAME(rate_hz);
+  SAME(status_rate_hz);
+  SAME(limits.max_velocity);
+  SAME(limits.max_acceleration);
+  SAME(limits.max_yaw_rate);
+  SAME(clearance.half_size);
+  SAME(clearance.margin);
+  SAME(clearance.brake_margin);
+  SAME(clearance.check_spacing);
+  SAME(clearance.allow_escape);
+  SAME(clearance.outside_is_obstacle);
+  SAME(trajectory.knot_interval);
+  SAME(trajectory.fallback_speed_factor);
+  SAME(optimizer.max_iterations);
+  SAME(optimizer.weight_smoothness);
+  SAME(optimizer.weight_clearance);
+  SAME(optimizer.weight_feasibility);
+  SAME(optimizer.target_margin);
+  SAME(optimizer.samples_per_segment);
+  SAME(path.max_waypoints);
+  SAME(path.max_segment_length);
+  SAME(path.max_start_offset);
+  SAME(path.max_age);
+  SAME(tracking.position_gain);
+  SAME(tracking.velocity_gain);
+  SAME(tracking.accel_feedforward);
+  SAME(tracking.yaw_feedforward);
+  SAME(tracking.max_command_speed);
+  SAME(safety.check_horizon);
+  SAME(safety.max_odometry_age);
+  SAME(safety.max_esdf_age);
+#undef SAME
+}
+
+TEST(ControllerConfig, OverridesAndErrors) {
+  const auto c = load_config<ControllerConfig>(
+      "", {"limits.max_velocity=0.7", "clearance.outside_window=obstacle", "optimizer.max_iterations=0"});
+  EXPECT_EQ(c.limits.max_velocity, 0.7);
+  EXPECT_TRUE(c.clearance.outside_is_obstacle);
+  EXPECT_EQ(c.optimizer.max_iterations, 0);
+  EXPECT_THROW(load_config<ControllerConfig>("", {"limits.max_velocty=0.7"}), ConfigError);
+  EXPECT_THROW(load_config<ControllerConfig>("", {"limits.max_velocity=-1"}), ConfigError);
+  EXPECT_THROW(load_config<ControllerConfig>("", {"clearance.outside_window=maybe"}), ConfigError);
+  EXPECT_THROW(load_config<ControllerConfig>("", {"clearance.brake_margin=0.2"}), ConfigError);
+}

@@ -1,0 +1,312 @@
+// Trajectory generation: limits on every sample, clearance on random cluttered ESDFs, the yaw
+// profile, the fallback and when there is no trajectory at all.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fields.hpp"
+#include "semx/controller/angles.hpp"
+#include "semx/controller/fallback.hpp"
+#include "semx/controller/synthetic_scene.hpp"
+#include "semx/controller/time_allocation.hpp"
+#include "semx/controller/trajectory_generator.hpp"
+
+using namespace semx::controller;
+using semx::controller::test::FreeField;
+using semx::controller::test::TubeField;
+
+namespace {
+
+constexpr double kSampleDt = 0.001;  // s: far denser than anything the generator does
+
+struct Extremes {
+  double speed = 0, acceleration = 0, yaw_rate = 0, min_distance = 1e300;
+};
+
+Extremes sample_all(const Trajectory& t, const DistanceField* field = nullptr) {
+  Extremes e;
+  for (double s = 0; s <= t.duration() + kSampleDt; s += kSampleDt) {
+    const TrajectoryPoint p = t.sample(s);
+    e.speed = std::max(e.speed, p.velocity.norm());
+    e.acceleration = std::max(e.acceleration, p.acceleration.norm());
+    e.yaw_rate = std::max(e.yaw_rate, std::abs(p.yaw_rate));
+    if (field) e.min_distance = std::min(e.min_distance, field->distance(p.position));
+  }
+  return e;
+}
+
+double distance_to_polyline(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& p) {
+  double best = 1e300;
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const Eigen::Vector3d d = pts[i + 1] - pts[i];
+    const double u = std::clamp((p - pts[i]).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (p - (pts[i] + u * d)).norm());
+  }
+  return best;
+}
+
+std::vector<double> unwrapped(std::vector<double> yaws) {
+  for (std::size_t k = 1; k < yaws.size(); ++k) yaws[k] = unwrap_near(yaws[k], yaws[k - 1]);
+  return yaws;
+}
+
+StartState at_rest(const Eigen::Vector3d& p, double yaw = 0) {
+  StartState s;
+  s.position = p;
+  s.yaw = yaw;
+  return s;
+}
+
+}  // namespace
+
+TEST(TimeAllocation, StartsStopsAndSlowsAtCorners) {
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {4, 0, 1}, {4, 4, 1}, {8, 4, 1}};
+  const TimedPolyline tp(pts, 0.0, 1.0, 2.0, 0.25);
+  EXPECT_LT((tp.position(0) - pts.front()).norm(), 1e-12);
+  EXPECT_LT((tp.position(tp.duration()) - pts.back()).norm(), 1e-12);
+  EXPECT_NEAR(tp.length(), 12.0, 1e-12);
+  ASSERT_EQ(tp.point_times().size(), 4u);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    EXPECT_LT((tp.position(tp.point_times()[i]) - pts[i]).norm(), 1e-9);
+  const double corner = TimedPolyline::corner_speed(M_PI / 2, 1.0, 2.0, 0.25);
+  EXPECT_NEAR(corner, 2.0 * 0.25 / (2 * std::sin(M_PI / 4)), 1e-12);
+  EXPECT_NEAR(tp.speed(tp.point_times()[1]), corner, 1e-6);
+  EXPECT_NEAR(tp.speed(1.0 + 0.5), 1.0, 1e-9);  // cruising after 0.5 s of acceleration
+  double prev = 0;
+  for (double t = 0; t <= tp.duration(); t += 0.01) {
+    EXPECT_LE(tp.speed(t), 1.0 + 1e-12);
+    const double s = (tp.position(t) - pts.front()).norm();
+    if (t < tp.point_times()[1]) {
+      EXPECT_GE(s, prev - 1e-12);  // moves forward along the first segment
+      prev = s;
+    }
+  }
+}
+
+TEST(TrajectoryGeneration, StraightPathInFreeSpaceIsFastSmoothAndEndsAtRest) {
+  const ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {10, 0, 1}};
+  const GenerationResult r = gen.generate(pts, {0.0, 0.0}, at_rest(pts[0]), 0.0, FreeField());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_TRUE(r.trajectory.optimized);
+  const Trajectory& t = r.trajectory;
+  EXPECT_LT((t.position_at(0) - pts[0]).norm(), 1e-9);
+  EXPECT_LT((t.end_position() - pts[1]).norm(), 1e-9);
+  EXPECT_LT(t.sample(t.duration()).velocity.norm(), 1e-9);
+  EXPECT_LT(t.sample(0).velocity.norm(), 1e-9);
+  EXPECT_GT(t.sample(0.5 * t.duration()).velocity.x(), 0.95);  // cruises near the limit
+  EXPECT_LT(t.duration(), 10.0 / 1.0 + 2.0);                   // ≈ L/v + the ramps
+  const Extremes e = sample_all(t);
+  EXPECT_LE(e.speed, 1.0 + 1e-6);
+  EXPECT_LE(e.acceleration, 2.0 + 1e-6);
+}
+
+TEST(TrajectoryGeneration, LimitsAreRespectedOnEverySample) {
+  // Random cluttered scenes, random start velocities, random path speed limits and limits.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int checked = 0;
+  for (int seed = 0; seed < 16; ++seed) {
+    ControllerConfig cfg;
+    cfg.limits.max_velocity = 0.6 + 0.3 * (seed % 4);
+    cfg.limits.max_acceleration = 1.0 + 0.5 * (seed % 3);
+    cfg.limits.max_yaw_rate = 0.5 + 0.25 * (seed % 5);
+    const TrajectoryGenerator gen(cfg);
+    const SyntheticScene scene = make_cluttered_scene(100 + seed);
+    StartState start = at_rest(scene.path.front(), u(rng) * M_PI);
+    start.velocity = Eigen::Vector3d(u(rng), u(rng), 0.3 * u(rng));
+    const double path_speed = seed % 2 ? 0.0 : 0.5 + 0.4 * (u(rng) + 1);
+    std::vector<double> yaws = scene.yaws;
+    yaws[0] = start.yaw;
+    const GenerationResult r = gen.generate(scene.path, unwrapped(yaws), start, path_speed, scene.field);
+    ASSERT_TRUE(r.ok) << "seed " << seed << ": " << r.reason;
+    const double v_lim = gen.speed_limit(path_speed);
+    const Extremes e = sample_all(r.trajectory);
+    EXPECT_LE(e.speed, v_lim * (1 + 1e-6)) << "seed " << seed;
+    EXPECT_LE(e.acceleration, cfg.limits.max_acceleration * (1 + 1e-6)) << "seed " << seed;
+    EXPECT_LE(e.yaw_rate, cfg.limits.max_yaw_rate * (1 + 1e-6)) << "seed " << seed;
+    // The bounds the generator used are the convex-hull ones, which the samples confirm.
+    EXPECT_LE(e.speed, r.trajectory.max_speed() * (1 + 1e-9));
+    ++checked;
+  }
+  EXPECT_EQ(checked, 16);
+}
+
+TEST(TrajectoryGeneration, ClearanceNeverBelowTheBoundOnRandomClutteredEsdfs) {
+  const ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const double bound = cfg.clearance.bound();
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int optimized = 0;
+  const int seeds = 40;
+  for (int seed = 0; seed < seeds; ++seed) {
+    SceneOptions so;
+    so.obstacles = 60 + (seed % 3) * 30;  // denser and denser clutter
+    // The path keeps 0.45 m (exact) from the boxes: on the grid the fallback just passes.
+    const SyntheticScene scene = make_cluttered_scene(500 + seed, so);
+    StartState start = at_rest(scene.path.front(), scene.yaws.front());
+    if (seed % 2) start.velocity = 0.8 * Eigen::Vector3d(u(rng), u(rng), 0.2 * u(rng));
+    const GenerationResult r = gen.generate(scene.path, unwrapped(scene.yaws), start, 0.0, scene.field);
+    ASSERT_TRUE(r.ok) << "seed " << seed << ": " << r.reason;  // the path itself is always safe
+    const Extremes e = sample_all(r.trajectory, &scene.field);
+    EXPECT_GE(e.min_distance, bound) << "seed " << seed
+                                     << (r.trajectory.optimized ? " optimised" : " fallback");
+    // The true geometry agrees with the grid to within its interpolation error.
+    EXPECT_GE(r.clearance.min_distance, bound);
+    optimized += r.trajectory.optimized ? 1 : 0;
+  }
+  EXPECT_GE(optimized, seeds * 8 / 10) << "the optimiser should usually succeed";
+}
+
+TEST(TrajectoryGeneration, OptimiserLowersItsCostAndKeepsTheEnds) {
+  const ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const TrajectoryOptimizer opt(cfg.optimizer);
+  const SyntheticScene scene = make_cluttered_scene(42);
+  PositionSpline s = gen.initial_spline(scene.path, at_rest(scene.path.front()), 1.0);
+  const PositionSpline before = s;
+  const OptimizerReport r =
+      opt.optimize(s, scene.field, 1.0, 2.0, cfg.clearance.bound() + cfg.optimizer.target_margin);
+  ASSERT_TRUE(r.ran);
+  EXPECT_FALSE(r.failed);
+  EXPECT_LT(r.final_cost, r.initial_cost);
+  EXPECT_GT(r.iterations, 0);
+  for (int i : {0, 1, 2, s.size() - 3, s.size() - 2, s.size() - 1}) {
+    EXPECT_EQ(s.control_points()[i], before.control_points()[i]) << i;
+  }
+}
+
+TEST(TrajectoryGeneration, StartStateIsTheVehiclesAndPathSpeedLowersTheLimit) {
+  ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {3, 0, 1}, {3, 3, 1}};
+  StartState start = at_rest(pts[0]);
+  start.velocity = Eigen::Vector3d(0.5, 0.1, 0.0);
+  const GenerationResult r = gen.generate(pts, {0, 0, 0}, start, 0.6, FreeField());
+  ASSERT_TRUE(r.ok);
+  const TrajectoryPoint p0 = r.trajectory.sample(0);
+  EXPECT_LT((p0.position - start.position).norm(), 1e-9);
+  EXPECT_LT((p0.velocity - start.velocity / r.time_scale).norm(), 1e-9);
+  EXPECT_LE(sample_all(r.trajectory).speed, 0.6 * (1 + 1e-6));
+}
+
+TEST(TrajectoryGeneration, YawTurnsTheShortWayToEachWaypointsHeading) {
+  ControllerConfig cfg;
+  cfg.limits.max_yaw_rate = 0.5;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {4, 0, 1}, {4, 4, 1}};
+  // From 3.0 rad to -3.0 rad is +0.28 rad through ±π, not -6 rad.
+  const std::vector<double> yaws = unwrapped({3.0, -3.0, -1.5});
+  EXPECT_NEAR(yaws[1], 2 * M_PI - 3.0, 1e-12);
+  const GenerationResult r = gen.generate(pts, yaws, at_rest(pts[0], 3.0), 0.0, FreeField());
+  ASSERT_TRUE(r.ok);
+  const Trajectory& t = r.trajectory;
+  EXPECT_NEAR(t.sample(0).yaw, 3.0, 1e-9);
+  EXPECT_NEAR(wrap_angle(t.end_yaw() - (-1.5)), 0.0, 1e-9);
+  // Monotone: every sample lies between the start yaw and the next target (no long way round).
+  for (double s = 0; s <= t.duration(); s += 0.01) {
+    const double y = t.sample(s).yaw;
+    EXPECT_GE(y, 3.0 - 1e-9);
+    EXPECT_LE(y, yaws[2] + 1e-9);
+  }
+  EXPECT_LE(sample_all(t).yaw_rate, 0.5 * (1 + 1e-6));
+}
+
+TEST(TrajectoryGeneration, ShortPathWithALargeTurnHoversUntilTheHeadingIsReached) {
+  ControllerConfig cfg;
+  cfg.limits.max_yaw_rate = 0.5;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {0.3, 0, 1}};
+  const GenerationResult r = gen.generate(pts, {0.0, 3.0}, at_rest(pts[0]), 0.0, FreeField());
+  ASSERT_TRUE(r.ok);
+  EXPECT_GE(r.trajectory.duration(), 3.0 / 0.5);  // the turn takes at least 6 s
+  EXPECT_NEAR(r.trajectory.end_yaw(), 3.0, 1e-9);
+  EXPECT_LT((r.trajectory.end_position() - pts[1]).norm(), 1e-9);
+  const Extremes e = sample_all(r.trajectory);
+  EXPECT_LE(e.yaw_rate, 0.5 * (1 + 1e-6));
+}
+
+TEST(TrajectoryGeneration, DisabledOptimiserFallsBackToThePolylineAtLowerSpeed) {
+  ControllerConfig cfg;
+  cfg.optimizer.max_iterations = 0;
+  const TrajectoryGenerator gen(cfg);
+  const SyntheticScene scene = make_cluttered_scene(3);
+  const GenerationResult r =
+      gen.generate(scene.path, unwrapped(scene.yaws), at_rest(scene.path.front()), 0.0, scene.field);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_FALSE(r.trajectory.optimized);
+  EXPECT_NE(r.reason.find("optimiser disabled"), std::string::npos) << r.reason;
+  const Extremes e = sample_all(r.trajectory, &scene.field);
+  EXPECT_LE(e.speed, cfg.limits.max_velocity * cfg.trajectory.fallback_speed_factor * (1 + 1e-6));
+  EXPECT_LE(e.acceleration, cfg.limits.max_acceleration * (1 + 1e-6));
+  EXPECT_GE(e.min_distance, cfg.clearance.bound());
+  for (double s = 0; s <= r.trajectory.duration(); s += 0.005) {
+    ASSERT_LT(distance_to_polyline(scene.path, r.trajectory.position_at(s)), 1e-9) << "off the path at " << s;
+  }
+}
+
+TEST(TrajectoryGeneration, ImpossibleCorridorFallsBack) {
+  // Free only within ~1 cm of a zig-zag: any smooth curve cuts a corner and collides.
+  const ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {2, 0, 1}, {2, 2, 1}, {0, 2, 1}, {0, 4, 1}};
+  const TubeField tube(pts, cfg.clearance.bound() + 0.5 * cfg.clearance.check_spacing + 0.01);
+  const GenerationResult r = gen.generate(pts, {0, 0, 0, 0, 0}, at_rest(pts[0]), 0.0, tube);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_FALSE(r.trajectory.optimized);
+  EXPECT_NE(r.reason.find("too close"), std::string::npos) << r.reason;
+  EXPECT_GE(sample_all(r.trajectory, &tube).min_distance, cfg.clearance.bound());
+}
+
+TEST(TrajectoryGeneration, PathThroughAWallHasNoTrajectory) {
+  const ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  const std::vector<Box> wall{{Eigen::Vector3d(2.0, -3, 0), Eigen::Vector3d(2.2, 3, 3)}};
+  const GridDistanceField field =
+      rasterize_boxes(wall, Eigen::Vector3d(-1, -4, 0), 0.1, 60, 80, 30, 2.0, OutsideWindow::kFree);
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {4, 0, 1}};
+  const GenerationResult r = gen.generate(pts, {0, 0}, at_rest(pts[0]), 0.0, field);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("no safe trajectory"), std::string::npos) << r.reason;
+}
+
+TEST(TrajectoryGeneration, AVehicleTooCloseToAWallMayOnlyEscape) {
+  ControllerConfig cfg;
+  const std::vector<Box> wall{{Eigen::Vector3d(-1.0, -3, 0), Eigen::Vector3d(-0.35, 3, 3)}};
+  const GridDistanceField field =
+      rasterize_boxes(wall, Eigen::Vector3d(-2, -4, 0), 0.1, 80, 80, 30, 2.0, OutsideWindow::kFree);
+  const Eigen::Vector3d start(0.0, 0.0, 1.0);  // 0.35 m from the wall: below the 0.4 m bound
+  ASSERT_LT(field.distance(start), cfg.clearance.bound());
+  {
+    const TrajectoryGenerator gen(cfg);
+    const std::vector<Eigen::Vector3d> away{start, {3, 0, 1}};
+    const GenerationResult r = gen.generate(away, {0, 0}, at_rest(start), 0.0, field);
+    ASSERT_TRUE(r.ok) << r.reason;
+    EXPECT_TRUE(r.clearance.escaping);
+    EXPECT_GE(sample_all(r.trajectory, &field).min_distance, field.distance(start) - 0.011);
+    // Along the wall it would not get out: refused.
+    const std::vector<Eigen::Vector3d> along{start, {0, 3, 1}};
+    EXPECT_FALSE(gen.generate(along, {0, 0}, at_rest(start), 0.0, field).ok);
+  }
+  cfg.clearance.allow_escape = false;
+  const TrajectoryGenerator strict(cfg);
+  EXPECT_FALSE(strict.generate({start, {3, 0, 1}}, {0, 0}, at_rest(start), 0.0, field).ok);
+}
+
+TEST(Fallback, StopsAtEveryWaypointWithinTheLimits) {
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 0}, {1, 0, 0}, {1, 0.05, 0}, {3, 2, 1}};
+  const FallbackSpline fb = make_fallback_spline(pts, 0.5, 2.0, 0.25);
+  ASSERT_EQ(fb.point_times.size(), pts.size());
+  Trajectory t;
+  t.position = fb.spline;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const TrajectoryPoint p = t.sample(fb.point_times[i]);
+    EXPECT_LT((p.position - pts[i]).norm(), 1e-12) << i;
+    EXPECT_LT(p.velocity.norm(), 1e-12) << i;
+  }
+  const Extremes e = sample_all(t);
+  EXPECT_LE(e.speed, 0.5 * (1 + 1e-9));
+  EXPECT_LE(e.acceleration, 2.0 * (1 + 1e-9));
+}
