@@ -1,0 +1,58 @@
+// Computes the Euclidean signed distance field over a window around the vehicle (ESDF_LOCAL).
+//
+// Obstacle voxels are the occupied ones, plus the unknown ones when unknown_as_occupied. For a
+// voxel outside obstacles the value is the distance from its centre to the nearest obstacle
+// voxel's centre minus half a voxel (so it approximates the distance to the obstacle's face and
+// is continuous in sign across a boundary); inside obstacles it is minus the same distance to the
+// nearest non-obstacle voxel. Values are clamped to +-max_distance. Only voxels inside the window
+// are considered: an obstacle just outside it is not seen, so distances near the window border
+// are upper bounds (the window is centred on the vehicle, where the field matters).
+//
+// Computed exactly (Felzenszwalb & Huttenlocher's lower envelope of parabolas, one pass per axis)
+// over the whole window whenever it moved or a state inside it changed.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "semx/mapper/esdf_grid.hpp"
+#include "semx/mapper/mapper_config.hpp"
+#include "semx/mapper/state_grid.hpp"
+
+namespace semx::mapper {
+
+class EsdfBuilder {
+ public:
+  EsdfBuilder(const EsdfParams& params, double resolution);
+
+  // Recomputes the field over the window centred on `center` when the window moved, `changed`
+  // (voxels whose state changed since the last call) intersects it, or `force`. Returns whether
+  // it recomputed.
+  bool update(const StateGrid& grid, const Eigen::Vector3d& center, const KeyBox& changed, int64_t map_seq,
+              bool force = false);
+  const EsdfGrid& grid() const { return grid_; }
+  const EsdfParams& params() const { return params_; }
+  // Window placement for a vehicle at `center` (exposed for tests and the node).
+  VoxelKey window_origin(const Eigen::Vector3d& center) const;
+
+ private:
+  void compute(const StateGrid& grid);
+
+  EsdfParams params_;
+  EsdfGrid grid_;
+  std::vector<uint8_t> obstacle_;
+  std::vector<float> pos_, neg_;
+  std::vector<float> line_in_, line_out_, env_z_;
+  std::vector<int> env_v_;
+};
+
+// Squared Euclidean distance transform, in voxel units, of a dense nx*ny*nz grid (x fastest):
+// out[i] = squared distance from cell i to the nearest cell with site[i] == want, or a value
+// >= kEdtInfinity when there is none. Exposed for tests.
+inline constexpr float kEdtInfinity = 1.0e18f;
+void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, float* out,
+                 std::vector<float>& line_in, std::vector<float>& line_out, std::vector<float>& env_z,
+                 std::vector<int>& env_v);
+
+}  // namespace semx::mapper

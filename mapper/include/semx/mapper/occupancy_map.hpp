@@ -1,0 +1,95 @@
+// The mapper's log-odds occupancy map: a StateGrid whose blocks also carry log-odds.
+//
+// Update rule (OctoMap's): l <- clamp(l + l_hit) for a voxel an observation ends in, l <- clamp(l +
+// l_miss) for a voxel a ray passes through, with l starting at 0 for a never-observed voxel, in
+// float arithmetic with the constants computed as OctoMap computes them, so the same sequence of
+// per-voxel observations gives bit-identical log-odds in both. A voxel is occupied iff l >=
+// logit(threshold), free otherwise, unknown until first observed.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "semx/mapper/mapper_config.hpp"
+#include "semx/mapper/state_grid.hpp"
+
+namespace semx::mapper {
+
+class OccupancyMap {
+ public:
+  // Throws runtime::ConfigError for inconsistent parameters.
+  explicit OccupancyMap(const OccupancyParams& params);
+  OccupancyMap(OccupancyMap&&) = default;
+  OccupancyMap& operator=(OccupancyMap&&) = default;
+
+  const OccupancyParams& params() const { return params_; }
+  double resolution() const { return grid_.resolution(); }
+  const KeyMath& keys() const { return grid_.keys(); }
+  const StateGrid& grid() const { return grid_; }
+
+  float hit_log_odds() const { return l_hit_; }
+  float miss_log_odds() const { return l_miss_; }
+  float min_log_odds() const { return l_min_; }
+  float max_log_odds() const { return l_max_; }
+  float threshold_log_odds() const { return l_occ_; }
+  VoxelState classify(float log_odds) const {
+    return log_odds >= l_occ_ ? VoxelState::kOccupied : VoxelState::kFree;
+  }
+
+  // Whether updates may touch voxel k (always true without configured bounds).
+  bool in_bounds(const VoxelKey& k) const { return !bounded_ || bounds_.contains(k); }
+  // The updatable key box; empty optional when unbounded.
+  std::optional<KeyBox> bounds() const { return bounded_ ? std::optional<KeyBox>(bounds_) : std::nullopt; }
+
+  VoxelState state(const VoxelKey& k) const { return grid_.state(k); }
+  VoxelState state(const Eigen::Vector3d& p) const { return grid_.state(p); }
+  // Log-odds of a known voxel; nullopt for unknown ones.
+  std::optional<float> log_odds(const VoxelKey& k) const;
+
+  // One observation of one voxel (integration applies at most one per voxel per frame). Returns
+  // the new state; *changed tells whether the state changed. Out-of-bounds voxels are ignored.
+  VoxelState update(const VoxelKey& k, bool hit, bool* changed = nullptr);
+  // Sets a voxel's log-odds (clamped into [min, max]); NaN makes the voxel unknown again.
+  // For restoring checkpoints and building test scenes.
+  void set_log_odds(const VoxelKey& k, float log_odds);
+  // The same for a whole block: values[i] for local index i (NaN = unknown).
+  void set_block_log_odds(const VoxelKey& block_key, const float* values);
+  void clear() { grid_.clear(); }
+
+  // Batch path for the integrator: applies one observation to voxel i of block b and returns
+  // the state before and after.
+  void apply(VoxelBlock& b, const VoxelKey& k, int i, bool hit, VoxelState& before, VoxelState& after) {
+    before = b.state[i];
+    float l = b.log_odds[i] + (hit ? l_hit_ : l_miss_);
+    if (l < l_min_) l = l_min_;
+    if (l > l_max_) l = l_max_;
+    b.log_odds[i] = l;
+    after = classify(l);
+    if (after != before) {
+      b.state[i] = after;
+      grid_.note_transition(b, k, before, after);
+    }
+  }
+  VoxelBlock& block(const VoxelKey& block_key) { return grid_.get_or_create_block(block_key); }
+
+  // ---- the shared queries (see StateGrid) ----
+  bool is_frontier(const VoxelKey& k) const { return grid_.is_frontier(k); }
+  bool is_surface(const VoxelKey& k) const { return grid_.is_surface(k); }
+  bool is_visible(const Eigen::Vector3d& from, const Eigen::Vector3d& to, bool unknown_blocks = false) const {
+    return grid_.is_visible(from, to, unknown_blocks);
+  }
+  bool box_collides(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                    bool unknown_is_occupied = true) const {
+    return grid_.box_collides(lo, hi, unknown_is_occupied);
+  }
+  int64_t count_frontiers() const { return grid_.count_frontiers(); }
+
+ private:
+  OccupancyParams params_;
+  StateGrid grid_;
+  float l_hit_, l_miss_, l_min_, l_max_, l_occ_;
+  bool bounded_ = false;
+  KeyBox bounds_;
+};
+
+}  // namespace semx::mapper

@@ -1,0 +1,190 @@
+#include "semx/mapper/esdf_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace semx::mapper {
+
+namespace {
+
+// Values at or above this are "no site on this line" (kEdtInfinity, possibly plus a square).
+constexpr float kFiniteBelow = 1.0e17f;
+// Linear distances along the first axis saturate here; squared, it becomes kEdtInfinity.
+constexpr float kLinearInfinity = 1.0e9f;
+
+// 1-D squared distance transform of a sampled function (Felzenszwalb & Huttenlocher 2012),
+// building the lower envelope from finite samples only, so "no site" never enters the
+// intersection arithmetic.
+void edt_1d(const float* f, int n, float* d, int* v, float* z) {
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (!(f[q] < kFiniteBelow)) continue;
+    const float fq = f[q] + static_cast<float>(q) * q;
+    // Pop the parabolas the new one hides: s <= z[k] with s = (fq - fp) / (2 (q - p)), compared
+    // as a product so that only the kept intersection costs a division.
+    while (k >= 0) {
+      const int p = v[k];
+      const float num = fq - (f[p] + static_cast<float>(p) * p);
+      const float den = 2.0f * static_cast<float>(q - p);
+      if (num > z[k] * den) break;
+      --k;
+    }
+    ++k;
+    v[k] = q;
+    if (k == 0) {
+      z[k] = -std::numeric_limits<float>::infinity();
+    } else {
+      const int p = v[k - 1];
+      z[k] = (fq - (f[p] + static_cast<float>(p) * p)) / (2.0f * static_cast<float>(q - p));
+    }
+  }
+  if (k < 0) {
+    for (int q = 0; q < n; ++q) d[q] = kEdtInfinity;
+    return;
+  }
+  z[k + 1] = std::numeric_limits<float>::infinity();
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < static_cast<float>(q)) ++j;
+    const float dq = static_cast<float>(q - v[j]);
+    d[q] = dq * dq + f[v[j]];
+  }
+}
+
+}  // namespace
+
+void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, float* out,
+                 std::vector<float>& line_in, std::vector<float>& line_out, std::vector<float>& env_z,
+                 std::vector<int>& env_v) {
+  const size_t plane = static_cast<size_t>(nx) * ny;
+  const int longest = std::max({nx, ny, nz});
+  line_in.resize(longest);
+  line_out.resize(longest);
+  env_z.resize(longest + 1);
+  env_v.resize(longest);
+
+  // z first, as plane-wide linear sweeps: contiguous and vectorisable, and a binary image needs
+  // no parabolas on its first axis.
+  for (size_t i = 0; i < plane; ++i) out[i] = site[i] == want ? 0.0f : kLinearInfinity;
+  for (int z = 1; z < nz; ++z) {
+    const uint8_t* s = site + z * plane;
+    float* o = out + z * plane;
+    const float* prev = o - plane;
+    for (size_t i = 0; i < plane; ++i) o[i] = s[i] == want ? 0.0f : std::min(prev[i] + 1.0f, kLinearInfinity);
+  }
+  for (int z = nz - 2; z >= 0; --z) {
+    float* o = out + z * plane;
+    const float* next = o + plane;
+    for (size_t i = 0; i < plane; ++i) o[i] = std::min(o[i], next[i] + 1.0f);
+  }
+  const size_t total = plane * nz;
+  for (size_t i = 0; i < total; ++i) out[i] = out[i] >= kLinearInfinity ? kEdtInfinity : out[i] * out[i];
+
+  // x: contiguous lines.
+  for (size_t line = 0; line < static_cast<size_t>(ny) * nz; ++line) {
+    float* o = out + line * nx;
+    edt_1d(o, nx, line_out.data(), env_v.data(), env_z.data());
+    std::memcpy(o, line_out.data(), sizeof(float) * nx);
+  }
+  // y: strided lines, gathered; a plane (nx*ny floats) stays in cache while its lines are done.
+  for (int z = 0; z < nz; ++z) {
+    float* base = out + z * plane;
+    for (int x = 0; x < nx; ++x) {
+      bool any = false;
+      for (int y = 0; y < ny; ++y) {
+        line_in[y] = base[x + static_cast<size_t>(nx) * y];
+        any |= line_in[y] < kFiniteBelow;
+      }
+      if (!any) continue;
+      edt_1d(line_in.data(), ny, line_out.data(), env_v.data(), env_z.data());
+      for (int y = 0; y < ny; ++y) base[x + static_cast<size_t>(nx) * y] = line_out[y];
+    }
+  }
+}
+
+EsdfBuilder::EsdfBuilder(const EsdfParams& params, double resolution) : params_(params) {
+  grid_.resolution = resolution;
+  grid_.max_distance = params.max_distance;
+  grid_.unknown_as_occupied = params.unknown_as_occupied;
+  int* dims[3] = {&grid_.nx, &grid_.ny, &grid_.nz};
+  for (int a = 0; a < 3; ++a) {
+    const double w = a < static_cast<int>(params.window.size()) ? params.window[a] : 2.0 * resolution;
+    *dims[a] = std::max(2, static_cast<int>(std::lround(w / resolution)));
+  }
+}
+
+VoxelKey EsdfBuilder::window_origin(const Eigen::Vector3d& center) const {
+  const KeyMath km(grid_.resolution);
+  const VoxelKey c = km.key(center);
+  return {c.x - grid_.nx / 2, c.y - grid_.ny / 2, c.z - grid_.nz / 2};
+}
+
+bool EsdfBuilder::update(const StateGrid& grid, const Eigen::Vector3d& center, const KeyBox& changed,
+                         int64_t map_seq, bool force) {
+  VoxelKey probe;
+  if (!KeyMath(grid_.resolution).key(center, probe)) return false;
+  const VoxelKey origin = window_origin(center);
+  KeyBox window;
+  window.min = origin;
+  window.max = origin + VoxelKey{grid_.nx - 1, grid_.ny - 1, grid_.nz - 1};
+  const bool recompute = force || grid_.empty() || origin != grid_.origin || changed.intersects(window);
+  grid_.map_seq = map_seq;
+  if (!recompute) return false;
+  grid_.origin = origin;
+  compute(grid);
+  return true;
+}
+
+void EsdfBuilder::compute(const StateGrid& grid) {
+  const int nx = grid_.nx, ny = grid_.ny, nz = grid_.nz;
+  const size_t n = static_cast<size_t>(nx) * ny * nz;
+  obstacle_.resize(n);
+  pos_.resize(n);
+  neg_.resize(n);
+  grid_.distance.resize(n);
+  const uint8_t unknown_value = params_.unknown_as_occupied ? 1 : 0;
+
+  // Block by block: one hash lookup per block of the window.
+  const VoxelKey o = grid_.origin;
+  const VoxelKey last = o + VoxelKey{nx - 1, ny - 1, nz - 1};
+  const VoxelKey bmin = block_of(o), bmax = block_of(last);
+  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
+    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
+      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
+        const VoxelBlock* b = grid.find_block({bx, by, bz});
+        const VoxelKey base{bx * kBlockSize, by * kBlockSize, bz * kBlockSize};
+        const int x0 = std::max(o.x, base.x), x1 = std::min(last.x, base.x + kBlockMask);
+        const int y0 = std::max(o.y, base.y), y1 = std::min(last.y, base.y + kBlockMask);
+        const int z0 = std::max(o.z, base.z), z1 = std::min(last.z, base.z + kBlockMask);
+        for (int z = z0; z <= z1; ++z) {
+          for (int y = y0; y <= y1; ++y) {
+            uint8_t* dst = &obstacle_[grid_.index(x0 - o.x, y - o.y, z - o.z)];
+            if (!b) {
+              std::memset(dst, unknown_value, x1 - x0 + 1);
+              continue;
+            }
+            const VoxelState* row =
+                &b->state[((y - base.y) << kBlockBits) | ((z - base.z) << (2 * kBlockBits))];
+            for (int x = x0; x <= x1; ++x) {
+              const VoxelState s = row[x - base.x];
+              dst[x - x0] = s == VoxelState::kOccupied ? 1 : (s == VoxelState::kUnknown ? unknown_value : 0);
+            }
+          }
+        }
+      }
+    }
+  }
+
+  squared_edt(obstacle_.data(), 1, nx, ny, nz, pos_.data(), line_in_, line_out_, env_z_, env_v_);
+  squared_edt(obstacle_.data(), 0, nx, ny, nz, neg_.data(), line_in_, line_out_, env_z_, env_v_);
+  const float res = static_cast<float>(grid_.resolution);
+  const float dmax = static_cast<float>(params_.max_distance);
+  for (size_t i = 0; i < n; ++i) {
+    const float d = obstacle_[i] ? -(std::sqrt(neg_[i]) - 0.5f) * res : (std::sqrt(pos_[i]) - 0.5f) * res;
+    grid_.distance[i] = std::min(std::max(d, -dmax), dmax);
+  }
+}
+
+}  // namespace semx::mapper

@@ -1,0 +1,150 @@
+// The ESDF window against brute force.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "mapper_test_util.hpp"
+
+namespace semx::mapper {
+namespace {
+
+// Brute-force value of one voxel, by the definition in esdf.hpp.
+float brute_distance(const StateGrid& g, const EsdfGrid& e, int x, int y, int z) {
+  auto obstacle = [&](int i, int j, int k) {
+    const VoxelState s = g.state(e.origin + VoxelKey{i, j, k});
+    return s == VoxelState::kOccupied || (e.unknown_as_occupied && s == VoxelState::kUnknown);
+  };
+  const bool inside = obstacle(x, y, z);
+  double best = 1e30;
+  for (int k = 0; k < e.nz; ++k)
+    for (int j = 0; j < e.ny; ++j)
+      for (int i = 0; i < e.nx; ++i)
+        if (obstacle(i, j, k) != inside)
+          best = std::min(best, double((i - x) * (i - x) + (j - y) * (j - y) + (k - z) * (k - z)));
+  const double d = (std::sqrt(best) - 0.5) * e.resolution;
+  const double clamped = std::min(d, e.max_distance);
+  return static_cast<float>(inside ? -clamped : clamped);
+}
+
+TEST(Esdf, MatchesBruteForceOnRandomScenes) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const bool unknown_as_occupied : {true, false}) {
+    for (int trial = 0; trial < 3; ++trial) {
+      EsdfParams p;
+      p.window = {2.0, 1.6, 0.8};
+      p.max_distance = 0.6;
+      p.unknown_as_occupied = unknown_as_occupied;
+      EsdfBuilder builder(p, 0.1);
+      const Eigen::Vector3d center(0.3, -0.45, 1.0);
+      const VoxelKey o = builder.window_origin(center);
+      StateGrid g(0.1);
+      // Mostly free with scattered obstacles and an unknown corner; a little margin outside the
+      // window shows that outside voxels are ignored.
+      for (int z = -1; z <= 8; ++z)
+        for (int y = -1; y <= 16; ++y)
+          for (int x = -1; x <= 20; ++x) {
+            const double r = u(rng);
+            const VoxelKey k = o + VoxelKey{x, y, z};
+            if (x < 4 && y < 4 && z < 3) continue;  // unknown
+            g.set_state(k, r < 0.04 ? VoxelState::kOccupied : VoxelState::kFree);
+          }
+      ASSERT_TRUE(builder.update(g, center, KeyBox(), 7));
+      const EsdfGrid& e = builder.grid();
+      ASSERT_EQ(e.nx, 20);
+      ASSERT_EQ(e.ny, 16);
+      ASSERT_EQ(e.nz, 8);
+      EXPECT_EQ(e.origin, o);
+      EXPECT_EQ(e.map_seq, 7);
+      for (int z = 0; z < e.nz; ++z)
+        for (int y = 0; y < e.ny; ++y)
+          for (int x = 0; x < e.nx; ++x)
+            ASSERT_NEAR(e.distance[e.index(x, y, z)], brute_distance(g, e, x, y, z), 1e-5)
+                << x << " " << y << " " << z << " unknown_as_occupied " << unknown_as_occupied;
+    }
+  }
+}
+
+TEST(Esdf, InterpolationAndGradientPointAwayFromAnObstacle) {
+  EsdfParams p;
+  p.window = {3.0, 3.0, 3.0};
+  p.max_distance = 5.0;
+  p.unknown_as_occupied = false;
+  EsdfBuilder builder(p, 0.1);
+  StateGrid g(0.1);
+  g.set_state({0, 0, 0}, VoxelState::kOccupied);
+  builder.update(g, Eigen::Vector3d(0.05, 0.05, 0.05), KeyBox(), 1);
+  const EsdfGrid& e = builder.grid();
+  double d;
+  Eigen::Vector3d grad;
+  // At a voxel centre the interpolation is the voxel's value.
+  ASSERT_TRUE(e.interpolate(Eigen::Vector3d(0.55, 0.05, 0.05), &d, &grad));
+  EXPECT_NEAR(d, 0.45, 1e-6);
+  EXPECT_NEAR(grad.x(), 1.0, 1e-6);
+  // Between centres, the gradient matches finite differences of the interpolation.
+  const Eigen::Vector3d p0(0.43, 0.37, -0.21);
+  ASSERT_TRUE(e.interpolate(p0, &d, &grad));
+  const double h = 1e-5;
+  for (int a = 0; a < 3; ++a) {
+    double dp, dm;
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    step[a] = h;
+    ASSERT_TRUE(e.interpolate(p0 + step, &dp, nullptr));
+    ASSERT_TRUE(e.interpolate(p0 - step, &dm, nullptr));
+    EXPECT_NEAR(grad[a], (dp - dm) / (2 * h), 1e-4) << a;
+  }
+  EXPECT_GT(grad.dot(p0 - Eigen::Vector3d(0.05, 0.05, 0.05)), 0.0) << "the gradient points away";
+  // Inside the obstacle the value is negative.
+  float v;
+  ASSERT_TRUE(e.voxel_distance({0, 0, 0}, &v));
+  EXPECT_FLOAT_EQ(v, -0.05f);
+  EXPECT_FALSE(e.interpolate(Eigen::Vector3d(10, 0, 0), &d, nullptr));
+  EXPECT_FALSE(e.interpolate(Eigen::Vector3d(std::nan(""), 0, 0), &d, nullptr));
+}
+
+TEST(Esdf, RecomputesOnlyWhenTheWindowMovesOrSomethingInsideChanged) {
+  EsdfParams p;
+  p.window = {2.0, 2.0, 1.0};
+  EsdfBuilder builder(p, 0.1);
+  StateGrid g(0.1);
+  const Eigen::Vector3d c(1.0, 1.0, 1.0);
+  EXPECT_TRUE(builder.update(g, c, KeyBox(), 1));
+  EXPECT_FALSE(builder.update(g, c, KeyBox(), 2));
+  EXPECT_EQ(builder.grid().map_seq, 2) << "still valid for the newer map";
+  KeyBox far;
+  far.include({500, 500, 500});
+  EXPECT_FALSE(builder.update(g, c, far, 3));
+  KeyBox near;
+  near.include(KeyMath(0.1).key(c));
+  EXPECT_TRUE(builder.update(g, c, near, 4));
+  EXPECT_TRUE(builder.update(g, c + Eigen::Vector3d(0.1, 0, 0), KeyBox(), 5));
+  EXPECT_FALSE(builder.update(g, Eigen::Vector3d(std::nan(""), 0, 0), near, 6));
+}
+
+TEST(Esdf, MapperKeepsTheWindowAroundTheVehicle) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  Mapper mapper{MapperConfig{}};
+  const auto frames = test::room_frames(4, cam, 4);
+  for (const auto& f : frames) {
+    mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+    ASSERT_TRUE(mapper.update_esdf(f.pose.translation()));
+  }
+  const EsdfGrid& e = mapper.esdf();
+  EXPECT_EQ(e.nx, 100);
+  EXPECT_EQ(e.ny, 100);
+  EXPECT_EQ(e.nz, 30);
+  EXPECT_EQ(e.map_seq, mapper.seq());
+  // A metre in front of the camera is seen free space, over half a metre from anything the
+  // last frame did not see (which counts as an obstacle).
+  double d;
+  ASSERT_TRUE(e.interpolate(frames.back().pose * Eigen::Vector3d(0, 0, 1.0), &d));
+  EXPECT_GT(d, 0.3);
+  // Points inside the table are inside an obstacle.
+  ASSERT_TRUE(e.interpolate(Eigen::Vector3d(1.6, 1.4, 0.5), &d));
+  EXPECT_LT(d, 0.0);
+  // Nothing changed: no recomputation.
+  EXPECT_FALSE(mapper.update_esdf(frames.back().pose.translation()));
+}
+
+}  // namespace
+}  // namespace semx::mapper

@@ -1,0 +1,231 @@
+// Deltas, snapshots and the map mirror (what MAP_UPDATE / MAP_SNAPSHOT carry).
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <set>
+
+#include "mapper_test_util.hpp"
+
+namespace semx::mapper {
+namespace {
+
+void expect_same(const StateGrid& a, const StateGrid& b) {
+  VoxelKey diff;
+  const bool same = a.same_states(b, &diff);
+  EXPECT_TRUE(same) << "first difference at " << diff.x << " " << diff.y << " " << diff.z << ": "
+                    << to_string(a.state(diff)) << " vs " << to_string(b.state(diff));
+  EXPECT_EQ(a.free_voxels(), b.free_voxels());
+  EXPECT_EQ(a.occupied_voxels(), b.occupied_voxels());
+}
+
+TEST(Streaming, SnapshotRoundTripIsExact) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  Mapper mapper{MapperConfig{}};
+  for (const auto& f : test::room_frames(6, cam, 6)) mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+  const MapSnapshot snap = mapper.snapshot(123);
+  EXPECT_EQ(snap.seq, 6);
+  EXPECT_EQ(snap.utime, 123);
+  EXPECT_EQ(snap.encoding, kSnapshotBlocksZlib);
+  StateGrid copy(0.1);
+  decode_snapshot(snap, copy);
+  expect_same(mapper.map().grid(), copy);
+  EXPECT_EQ(copy.count_frontiers(), mapper.map().count_frontiers());
+  // Deterministic: the same map encodes to the same bytes; and it is compressed.
+  EXPECT_EQ(encode_snapshot(copy, 6, 123).data, snap.data);
+  EXPECT_LT(snap.data.size(), static_cast<size_t>(mapper.map().grid().known_voxels() / 4));
+}
+
+TEST(Streaming, EmptyMapSnapshot) {
+  StateGrid empty(0.1), out(0.1);
+  out.set_state({1, 2, 3}, VoxelState::kFree);
+  decode_snapshot(encode_snapshot(empty, 0), out);
+  EXPECT_EQ(out.known_voxels(), 0);
+  EXPECT_EQ(out.state(VoxelKey{1, 2, 3}), VoxelState::kUnknown);
+}
+
+TEST(Streaming, MalformedSnapshotsAreRejectedAndLeaveTheMirrorAlone) {
+  StateGrid g(0.1);
+  for (int i = 0; i < 50; ++i) g.set_state({i, -i, 2 * i}, i % 3 ? VoxelState::kFree : VoxelState::kOccupied);
+  const MapSnapshot good = encode_snapshot(g, 5);
+  MapMirror mirror(0.1);
+  ASSERT_EQ(mirror.apply(good), MapMirror::SnapshotResult::kApplied);
+
+  auto rejected = [&](MapSnapshot s, const char* what) {
+    s.seq = 9;  // newer, so that only its content can make the mirror refuse it
+    EXPECT_EQ(mirror.apply(s), MapMirror::SnapshotResult::kRejected) << what;
+    EXPECT_EQ(mirror.seq(), 5) << what;
+    expect_same(mirror.grid(), g);
+  };
+  MapSnapshot s = good;
+  s.data.resize(s.data.size() / 2);
+  rejected(s, "truncated");
+  s = good;
+  s.data[s.data.size() / 2] ^= 0x5A;
+  rejected(s, "flipped byte");
+  s = good;
+  s.encoding = 7;
+  rejected(s, "unknown encoding");
+  s = good;
+  s.resolution = 0.2;
+  rejected(s, "resolution");
+  s = good;
+  s.data.assign({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x7F, 1, 2, 3});
+  rejected(s, "absurd size");
+  s = good;
+  s.data.clear();
+  rejected(s, "empty");
+  EXPECT_FALSE(mirror.last_error().empty());
+  EXPECT_EQ(mirror.counters().snapshots_rejected, 6);
+}
+
+TEST(Streaming, MirrorFollowsEveryDelta) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  Mapper mapper{MapperConfig{}};
+  MapMirror mirror(0.1);
+  for (const auto& f : test::room_frames(5, cam, 5)) {
+    const FrameResult r = mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+    ASSERT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kApplied);
+    ASSERT_EQ(mirror.seq(), mapper.seq());
+    expect_same(mirror.grid(), mapper.map().grid());
+  }
+}
+
+// The acceptance test: deltas lost on the way, the mirror asks for a snapshot, which
+// arrives a couple of frames later; at the end the mirror equals the map exactly.
+TEST(Streaming, MirrorRecoversFromLostDeltasBySnapshot) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  Mapper mapper{MapperConfig{}};
+  MapMirror mirror(0.1);
+  const std::set<int64_t> lost = {3, 7, 8, 15};
+  std::deque<MapSnapshot> in_flight;  // snapshot requests are answered with a delay
+  int requests = 0;
+  bool requested = false;
+  for (const auto& f : test::room_frames(20, cam, 20)) {
+    const FrameResult r = mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+    ASSERT_TRUE(r.report.accepted);
+    if (!lost.count(r.delta.seq)) mirror.apply(r.delta);
+    // A snapshot asked for earlier arrives after this frame's delta, which must be kept.
+    if (!in_flight.empty()) {
+      mirror.apply(in_flight.front());
+      in_flight.pop_front();
+      requested = false;
+    }
+    if (mirror.needs_snapshot() && !requested) {
+      ++requests;
+      requested = true;
+      in_flight.push_back(mapper.snapshot());  // taken now, delivered next frame
+    }
+  }
+  while (!in_flight.empty()) {
+    mirror.apply(in_flight.front());
+    in_flight.pop_front();
+  }
+  EXPECT_FALSE(mirror.needs_snapshot());
+  EXPECT_EQ(mirror.seq(), mapper.seq());
+  expect_same(mirror.grid(), mapper.map().grid());
+  EXPECT_EQ(mirror.counters().gaps, 3) << "7 and 8 are one gap";
+  EXPECT_EQ(requests, 3);
+  EXPECT_EQ(mirror.counters().snapshots_applied, 3);
+  // The deltas that arrived while waiting (4 5, 9 10, 16 17) were kept, and those newer than
+  // the snapshot (5, 10, 17) applied after it: every delivered delta but the gap-revealing ones.
+  EXPECT_EQ(mirror.counters().deltas_buffered, 6);
+  EXPECT_EQ(mirror.counters().deltas_applied, 20 - 4 - 3);
+}
+
+TEST(Streaming, MirrorRefusesDeltasAfterAGapUntilASnapshot) {
+  MapMirror mirror(0.1);
+  MapDelta d1{1, 0, 0.1, {{{0, 0, 0}, VoxelState::kFree}}};
+  MapDelta d3{3, 0, 0.1, {{{2, 0, 0}, VoxelState::kOccupied}}};
+  EXPECT_EQ(mirror.apply(d1), MapMirror::DeltaResult::kApplied);
+  EXPECT_EQ(mirror.apply(d3), MapMirror::DeltaResult::kBuffered);
+  EXPECT_TRUE(mirror.needs_snapshot());
+  EXPECT_EQ(mirror.state(VoxelKey{2, 0, 0}), VoxelState::kUnknown) << "not applied across the gap";
+  MapDelta d4{4, 0, 0.1, {{{3, 0, 0}, VoxelState::kFree}}};
+  EXPECT_EQ(mirror.apply(d4), MapMirror::DeltaResult::kBuffered);
+  // The mapper's map at seq 2, as a snapshot: then 3 and 4 are applied from the buffer.
+  StateGrid at2(0.1);
+  at2.set_state({0, 0, 0}, VoxelState::kFree);
+  at2.set_state({1, 0, 0}, VoxelState::kFree);
+  EXPECT_EQ(mirror.apply(encode_snapshot(at2, 2)), MapMirror::SnapshotResult::kApplied);
+  EXPECT_FALSE(mirror.needs_snapshot());
+  EXPECT_EQ(mirror.seq(), 4);
+  EXPECT_EQ(mirror.state(VoxelKey{1, 0, 0}), VoxelState::kFree);
+  EXPECT_EQ(mirror.state(VoxelKey{2, 0, 0}), VoxelState::kOccupied);
+  EXPECT_EQ(mirror.state(VoxelKey{3, 0, 0}), VoxelState::kFree);
+  // An old snapshot is ignored while in sequence.
+  EXPECT_EQ(mirror.apply(encode_snapshot(at2, 2)), MapMirror::SnapshotResult::kIgnored);
+  // Wrong resolution and out-of-range keys are rejected without touching the mirror.
+  MapDelta bad_res{5, 0, 0.2, {}};
+  EXPECT_EQ(mirror.apply(bad_res), MapMirror::DeltaResult::kRejected);
+  MapDelta bad_key{5, 0, 0.1, {{{kMaxKeyMagnitude, 0, 0}, VoxelState::kFree}}};
+  EXPECT_EQ(mirror.apply(bad_key), MapMirror::DeltaResult::kRejected);
+  MapDelta bad_state{5, 0, 0.1, {{{0, 0, 0}, static_cast<VoxelState>(9)}}};
+  EXPECT_EQ(mirror.apply(bad_state), MapMirror::DeltaResult::kRejected);
+  EXPECT_EQ(mirror.seq(), 4);
+  EXPECT_FALSE(mirror.needs_snapshot());
+}
+
+TEST(Streaming, MapperRestartMakesMirrorsResynchronise) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  const auto frames = test::room_frames(6, cam, 6);
+  const std::string path = test::temp_path("restart.map");
+  auto first = std::make_unique<Mapper>(MapperConfig{});
+  MapMirror mirror(0.1);
+  for (int i = 0; i < 4; ++i) {
+    mirror.apply(first->integrate(DepthFrame::view(cam, frames[i].pose, frames[i].depth)).delta);
+    if (i == 1) first->save_checkpoint(path, 0);  // checkpoint at seq 2, then two more frames
+  }
+  ASSERT_EQ(mirror.seq(), 4);
+  first.reset();  // the mapper dies
+
+  // Restarted from the checkpoint: its map lacks frames 3 and 4, which the mirror has.
+  Mapper second{MapperConfig{}};
+  second.load_checkpoint(path);
+  EXPECT_EQ(second.seq(), 2 + Mapper::kRestoreSequenceJump);
+  const FrameResult r = second.integrate(DepthFrame::view(cam, frames[4].pose, frames[4].depth));
+  EXPECT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kBuffered);
+  EXPECT_TRUE(mirror.needs_snapshot());
+  EXPECT_EQ(mirror.apply(second.snapshot()), MapMirror::SnapshotResult::kApplied);
+  expect_same(mirror.grid(), second.map().grid());
+
+  // A mapper restarted without a checkpoint begins again at seq 1: also a resync.
+  Mapper fresh{MapperConfig{}};
+  const FrameResult f1 = fresh.integrate(DepthFrame::view(cam, frames[5].pose, frames[5].depth));
+  EXPECT_EQ(mirror.apply(f1.delta), MapMirror::DeltaResult::kBuffered);
+  EXPECT_EQ(mirror.apply(fresh.snapshot()), MapMirror::SnapshotResult::kApplied);
+  expect_same(mirror.grid(), fresh.map().grid());
+  std::remove(path.c_str());
+}
+
+TEST(Streaming, StatsCountVolumesAndFrontiers) {
+  const runtime::PinholeCamera cam = test::small_camera();
+  Mapper mapper{MapperConfig{}};
+  for (const auto& f : test::room_frames(3, cam, 3)) mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+  const MapStats s = mapper.stats();
+  const StateGrid& g = mapper.map().grid();
+  EXPECT_EQ(s.seq, 3);
+  EXPECT_EQ(s.free_voxels, g.free_voxels());
+  EXPECT_NEAR(s.free_m3, g.free_voxels() * 1e-3, 1e-9);
+  EXPECT_NEAR(s.occupied_m3, g.occupied_voxels() * 1e-3, 1e-9);
+  EXPECT_NEAR(s.known_m3, s.free_m3 + s.occupied_m3, 1e-9);
+  EXPECT_EQ(s.frontier_voxels, g.count_frontiers());
+  EXPECT_GT(s.frontier_voxels, 0);
+  EXPECT_EQ(s.frames_integrated, 3);
+  // The room is 6 x 5 x 2.7 m with its corner at the origin: known space hugs it.
+  EXPECT_GT(s.bounds_min.x(), -0.21);
+  EXPECT_LT(s.bounds_max.x(), 6.21);
+  EXPECT_EQ(mapper.stats(false).frontier_voxels, -1);
+  // Free and occupied counts agree with a full scan.
+  int64_t free = 0, occ = 0;
+  g.for_each_block([&](const VoxelKey&, const VoxelBlock& b) {
+    for (VoxelState st : b.state) {
+      free += st == VoxelState::kFree;
+      occ += st == VoxelState::kOccupied;
+    }
+  });
+  EXPECT_EQ(free, s.free_voxels);
+  EXPECT_EQ(occ, s.occupied_voxels);
+}
+
+}  // namespace
+}  // namespace semx::mapper
