@@ -9,6 +9,7 @@
 #include <semx/odometry_t.hpp>
 #include <semx/rgb_image_t.hpp>
 
+#include "semx/runtime/image_codec.hpp"
 #include "semx/simulator/camera_frame.hpp"
 #include "semx/simulator/quadrotor.hpp"
 #include "semx/simulator/simulator.hpp"
@@ -19,11 +20,11 @@ semx::odometry_t to_message(const OdometrySample& s);
 semx::imu_t to_message(const ImuSample& s);
 semx::camera_info_t camera_info(const CameraFrame& f);
 
-// Images as little-endian bytes, zlib-compressed (level 1) when `compress`, which roughly
-// quarters depth frames on loopback at the cost of a few ms per frame.
-semx::depth_image_t depth_message(const CameraFrame& f, bool compress);
-semx::rgb_image_t rgb_message(const CameraFrame& f, bool compress);
-semx::label_image_t label_message(const CameraFrame& f, bool compress);
+// Images as little-endian bytes, encoded with the requested codec (runtime/image_codec.hpp;
+// the codec actually used is in the message, raw when encoding would not shrink it).
+semx::depth_image_t depth_message(const CameraFrame& f, runtime::ImageCompression codec);
+semx::rgb_image_t rgb_message(const CameraFrame& f, runtime::ImageCompression codec);
+semx::label_image_t label_message(const CameraFrame& f, runtime::ImageCompression codec);
 
 // Fails (returns false) on values no vehicle command can mean: unknown modes, NaN or infinite
 // numbers. Range limits are the quadrotor's business (it saturates or rejects).
@@ -31,7 +32,7 @@ bool well_formed(const semx::control_cmd_t& m);
 ControlCommand from_message(const semx::control_cmd_t& m);
 
 // Decodes an image payload back to raw bytes (for consumers and tests); false if the payload
-// does not decompress to exactly `expected_bytes`.
+// does not decode to exactly `expected_bytes`. Same as runtime::decode_image.
 bool image_bytes(int8_t compression, const std::vector<uint8_t>& payload, std::size_t expected_bytes,
                  std::vector<uint8_t>& out);
 

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
     std::string world = "env1", config_file, clock = "realtime", nodes;
     std::vector<std::string> sets;
     double speed = 1.0, duration = 0, period_ms = 10, progress = 10;
-    bool compress = false, no_rgb = false;
+    bool compress = false, raw = false, no_rgb = false;
     runtime::ArgParser p("semx-simulator",
                          "Simulates the world, the quadrotor and its RGB-D, label and IMU sensors, and publishes\n"
                          "them with SIM_CLOCK (docs/simulator.md).");
@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
                 &duration)
         .option("period-ms", "MS", "tick length in simulated ms (default 10, the odometry period)", &period_ms)
         .option("progress", "S", "simulated seconds between progress lines (0: none, default 10)", &progress)
-        .flag("compress", "zlib-compress image payloads", &compress)
+        .flag("compress", "zlib-compress every image payload (smaller logs, slower)", &compress)
+        .flag("raw-images", "send every image uncompressed (default: labels and RGB run-length coded)", &raw)
         .flag("no-rgb", "do not render or publish CAMERA_RGB", &no_rgb);
     if (!p.parse(argc, argv)) return 0;
     if (clock != "realtime" && clock != "lockstep") throw runtime::ArgError("--clock: '" + clock + "' is not realtime or lockstep");
@@ -53,7 +54,9 @@ int main(int argc, char** argv) {
       if (!n.empty()) o.clock.lockstep_nodes.push_back(n);
     }
     o.clock.max_ticks = duration > 0 ? static_cast<int64_t>(duration * 1e6 / static_cast<double>(o.clock.period_us)) + 1 : -1;
-    o.compress = compress;
+    if (compress && raw) throw runtime::ArgError("--compress and --raw-images exclude each other");
+    if (compress) o.depth_codec = o.label_codec = o.rgb_codec = runtime::ImageCompression::kZlib;
+    if (raw) o.label_codec = o.rgb_codec = runtime::ImageCompression::kNone;
     o.render_channels = no_rgb ? (simulator::kRenderDepth | simulator::kRenderLabels) : simulator::kRenderAll;
     o.progress_every_s = progress;
 

@@ -128,14 +128,16 @@ TEST(SimulatorNode, CompressedImagesRoundTrip) {
   Simulator sim(test::shipped("env1"), cfg);
   CameraFrame f;
   sim.render_camera(f);
-  for (bool compress : {false, true}) {
-    const auto d = depth_message(f, compress);
+  using runtime::ImageCompression;
+  for (auto codec : {ImageCompression::kNone, ImageCompression::kZlib, ImageCompression::kRle}) {
+    const bool compress = codec != ImageCompression::kNone;
+    const auto d = depth_message(f, codec);
     std::vector<uint8_t> raw;
     ASSERT_TRUE(image_bytes(d.compression, d.depth_data, f.depth.data.size() * 2, raw));
     for (std::size_t k = 0; k < f.depth.data.size(); ++k) {
       ASSERT_EQ(static_cast<uint16_t>(raw[2 * k] | raw[2 * k + 1] << 8), f.depth.data[k]);
     }
-    const auto l = label_message(f, compress);
+    const auto l = label_message(f, codec);
     ASSERT_TRUE(image_bytes(l.label_compression, l.label_data, f.class_label.data.size() * 4, raw));
     EXPECT_EQ(raw[0] | raw[1] << 8, f.class_label.data[0]);
     if (compress) {
