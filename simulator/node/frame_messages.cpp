@@ -14,10 +14,6 @@ void put_vec(double out[3], const Eigen::Vector3d& v) {
 // Little-endian bytes of a uint16 image (the wire format whatever the host).
 std::vector<uint8_t> le_bytes(const std::vector<uint16_t>& a) {
   std::vector<uint8_t> out(a.size() * 2);
-  if constexpr (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) {
-    std::memcpy(out.data(), a.data(), out.size());
-    return out;
-  }
   for (std::size_t i = 0; i < a.size(); ++i) {
     out[2 * i] = static_cast<uint8_t>(a[i] & 0xFF);
     out[2 * i + 1] = static_cast<uint8_t>(a[i] >> 8);
@@ -73,7 +69,12 @@ semx::depth_image_t depth_message(const CameraFrame& f, runtime::ImageCompressio
   m.utime = f.utime;
   m.info = camera_info(f);
   runtime::ImageCompression used;
-  m.depth_data = runtime::encode_image(le_bytes(f.depth.data), 2, codec, used);
+  if constexpr (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) {
+    m.depth_data = runtime::encode_image(reinterpret_cast<const uint8_t*>(f.depth.data.data()),
+                                         f.depth.data.size() * 2, 2, codec, used);
+  } else {
+    m.depth_data = runtime::encode_image(le_bytes(f.depth.data), 2, codec, used);
+  }
   m.compression = static_cast<int8_t>(used);
   m.num_depth_bytes = static_cast<int32_t>(m.depth_data.size());
   return m;
