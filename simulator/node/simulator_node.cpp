@@ -1,5 +1,6 @@
 #include "simulator_node.hpp"
 
+#include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/sim_event_t.hpp>
 
@@ -23,6 +24,7 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     : sim_(sim), node_(node), options_(std::move(options)), server_(options_.clock) {
   node_.subscribe<semx::control_cmd_t>(
       ch::CONTROL_CMD, [this](const semx::control_cmd_t& m) { on_command(m); }, &well_formed);
+  node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) { server_.on_ack(a.node, a.tick); });
   next_progress_s_ = options_.progress_every_s;
 }
 

@@ -1,6 +1,7 @@
 // The simulator process's node over memq://: what it publishes, in which order, and how it
 // treats commands, good and bad.
 #include <gtest/gtest.h>
+#include <semx/ack_t.hpp>
 #include <semx/camera_info_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/control_cmd_t.hpp>
@@ -183,4 +184,34 @@ TEST(SimulatorNode, SameSeedSameMessageStream) {
     if (a.channels[i] == "NODE_STATUS") continue;  // wall-clock liveness fields
     EXPECT_EQ(a.payloads[i], b.payloads[i]) << a.channels[i] << " #" << i;
   }
+}
+
+TEST(SimulatorNode, LockstepWaitsForEveryRegisteredNodesAck) {
+  SimulatorConfig cfg;
+  Simulator sim(test::shipped("env1"), cfg);
+  runtime::Node node(memq_node());
+  std::vector<int64_t> ticks;
+  node.subscribe<semx::clock_t>("SIM_CLOCK", [&](const semx::clock_t& c) { ticks.push_back(c.tick); });
+  auto options = lockstep(-1);
+  options.clock.lockstep_nodes = {"mapper", "planner"};
+  options.clock.resend_after_s = 1e9;
+  SimulatorNode sn(sim, node, options);
+  auto ack = [&](const std::string& who, int64_t tick) {
+    semx::ack_t a{};
+    a.node = who;
+    a.tick = tick;
+    node.publish("SIM_ACK", a);
+  };
+  double wall = 0;
+  for (int i = 0; i < 5; ++i) sn.poll(wall += 0.001);
+  node.drain();
+  EXPECT_EQ(ticks, std::vector<int64_t>{0}) << "no tick 1 before the acks";
+  ack("mapper", 0);
+  for (int i = 0; i < 5; ++i) sn.poll(wall += 0.001);
+  node.drain();
+  EXPECT_EQ(ticks, std::vector<int64_t>{0}) << "one of two acks is not enough";
+  ack("planner", 0);
+  for (int i = 0; i < 5; ++i) sn.poll(wall += 0.001);
+  node.drain();
+  EXPECT_EQ(ticks, (std::vector<int64_t>{0, 1}));
 }

@@ -1,0 +1,165 @@
+#include "map_replay.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+#include <semx/depth_image_t.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+#include "messages.hpp"
+#include "semx/mapper/map_export.hpp"
+#include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/wire_validator.hpp"
+
+namespace semx::mapper {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// lcm-logger's event header: u32 sync, i64 event number, i64 timestamp, i32 channel length,
+// i32 data length, all big-endian; then the channel name and the data.
+constexpr uint32_t kSync = 0xEDA1DA01u;
+constexpr size_t kHeaderBytes = 4 + 8 + 8 + 4 + 4;
+// LCM's reader asserts channel names shorter than 1000 bytes.
+constexpr int32_t kMaxChannelBytes = 999;
+
+uint32_t be32(const uint8_t* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | uint32_t{p[3]};
+}
+
+}  // namespace
+
+LogLayout scan_log(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw ReplayError(path + ": no such file");
+  if (fs::is_directory(path, ec)) throw ReplayError(path + ": is a directory, not an LCM log");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ReplayError(path + ": cannot open (" + std::strerror(errno) + ")");
+  LogLayout l;
+  l.file_bytes = fs::file_size(path, ec);
+  if (ec) throw ReplayError(path + ": cannot read its size (" + ec.message() + ")");
+  if (l.file_bytes == 0) throw ReplayError(path + ": empty file, not an LCM log");
+  uint64_t pos = 0;
+  uint8_t h[kHeaderBytes];
+  while (pos < l.file_bytes) {
+    if (l.file_bytes - pos < kHeaderBytes) {
+      l.truncated = true;
+      l.truncated_at = pos;
+      break;
+    }
+    in.seekg(static_cast<std::streamoff>(pos));
+    if (!in.read(reinterpret_cast<char*>(h), kHeaderBytes)) {
+      throw ReplayError(path + ": read error at byte " + std::to_string(pos));
+    }
+    const std::string where = " at byte " + std::to_string(pos) + " (event " + std::to_string(l.events) + ")";
+    if (be32(h) != kSync) {
+      throw ReplayError(pos == 0 ? path + ": not an LCM log (no event sync word at byte 0)"
+                                 : path + ": corrupt log: no event sync word" + where);
+    }
+    const auto channel_len = static_cast<int32_t>(be32(h + 20));
+    const auto data_len = static_cast<int32_t>(be32(h + 24));
+    if (channel_len <= 0 || channel_len > kMaxChannelBytes) {
+      throw ReplayError(path + ": corrupt log: channel name length " + std::to_string(channel_len) + where);
+    }
+    if (data_len < 0) throw ReplayError(path + ": corrupt log: negative data length" + where);
+    const uint64_t end =
+        pos + kHeaderBytes + static_cast<uint64_t>(channel_len) + static_cast<uint64_t>(data_len);
+    if (end > l.file_bytes) {
+      l.truncated = true;
+      l.truncated_at = pos;
+      break;
+    }
+    pos = end;
+    ++l.events;
+  }
+  if (l.events == 0) throw ReplayError(path + ": no complete LCM event (the file ends inside the first one)");
+  return l;
+}
+
+ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
+  ReplayReport r;
+  r.layout = scan_log(options.log_path);
+  lcm::LogFile log(options.log_path, "r");
+  if (!log.good()) throw ReplayError(options.log_path + ": lcm::LogFile cannot open it");
+
+  const runtime::LcmSchema& schema = runtime::LcmSchema::semx();
+  const runtime::LcmStruct* type = schema.find("semx.depth_image_t");
+  if (!type) throw ReplayError("no .lcm layout for semx.depth_image_t");
+  semx::depth_image_t msg;
+  DecodedDepth decoded;
+  auto note = [&](const std::string& why) {
+    if (r.first_error.empty()) r.first_error = why;
+  };
+  // Only the events the scan found complete: LogFile's reader is not safe past them.
+  for (int64_t i = 0; i < r.layout.events; ++i) {
+    const lcm::LogEvent* e = log.readNextEvent();
+    if (!e) throw ReplayError(options.log_path + ": lcm::LogFile stopped at event " + std::to_string(i));
+    ++r.channels[e->channel];
+    if (e->channel != options.channel) continue;
+    ++r.depth_events;
+    const auto* data = static_cast<const uint8_t*>(e->data);
+    const size_t size = static_cast<size_t>(e->datalen);
+    const runtime::WireError we =
+        runtime::validate_wire(schema, *type, semx::depth_image_t::getHash(), data, size);
+    if (we != runtime::WireError::kNone) {
+      ++r.malformed;
+      note("event " + std::to_string(i) + ": " + runtime::to_string(we));
+      continue;
+    }
+    try {
+      if (msg.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) {
+        ++r.malformed;
+        note("event " + std::to_string(i) + ": decoder rejected it");
+        continue;
+      }
+    } catch (const std::exception& ex) {
+      ++r.malformed;
+      note("event " + std::to_string(i) + ": decoder threw: " + ex.what());
+      continue;
+    }
+    std::string why = decode_depth(msg, decoded);
+    if (why.empty()) why = check_frame(decoded.frame());
+    if (!why.empty()) {
+      ++r.malformed;
+      note("event " + std::to_string(i) + ": " + why);
+      continue;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const FrameResult fr = mapper.integrate(decoded.frame());
+    r.integrate_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!fr.report.accepted) {
+      ++r.rejected;
+      note("event " + std::to_string(i) + ": " + fr.report.error);
+      continue;
+    }
+    ++r.integrated;
+    if (r.first_utime < 0) r.first_utime = msg.utime;
+    r.last_utime = std::max(r.last_utime, msg.utime);
+  }
+  return r;
+}
+
+std::vector<std::string> write_map_files(const Mapper& mapper, const std::string& dir, int64_t utime) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    throw MapIoError(dir + ": cannot create the output directory" + (ec ? " (" + ec.message() + ")" : ""));
+  }
+  const std::string base = (fs::path(dir) / "map").string();
+  std::vector<std::string> written;
+  mapper.save_checkpoint(base + ".ckpt", utime);
+  written.push_back(base + ".ckpt");
+  export_octomap_bt(mapper.map(), base + ".bt");
+  written.push_back(base + ".bt");
+  export_occupied_pcd(mapper.map().grid(), base + ".pcd");
+  written.push_back(base + ".pcd");
+  return written;
+}
+
+}  // namespace semx::mapper

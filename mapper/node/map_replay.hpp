@@ -1,0 +1,63 @@
+// Rebuilding a map from an lcm-logger log (semx-map-replay): every CAMERA_DEPTH event is
+// decoded and checked exactly as the mapper node does and integrated into a Mapper, with no
+// network and as fast as the frames integrate.
+//
+// Logs are read with lcm::LogFile, after a scan of the event headers: LCM 1.3.1's reader asserts
+// or allocates blindly on a corrupt header, so a file that is not a log, or is corrupt in the
+// middle, is refused with the byte offset of the problem before LCM reads it. A log whose last
+// event was cut short (lcm-logger killed while writing) is read up to that event, with a warning.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "semx/mapper/mapper.hpp"
+
+namespace semx::mapper {
+
+class ReplayError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The layout of an LCM log file, from its event headers alone.
+struct LogLayout {
+  int64_t events = 0;  // complete events
+  uint64_t file_bytes = 0;
+  bool truncated = false;     // the file ends inside an event
+  uint64_t truncated_at = 0;  // byte offset of that event
+};
+// Throws ReplayError naming the file: missing or unreadable, empty, not an LCM log, or a corrupt
+// event header (with its byte offset and event number).
+LogLayout scan_log(const std::string& path);
+
+struct ReplayOptions {
+  std::string log_path;
+  std::string channel = "CAMERA_DEPTH";
+};
+
+struct ReplayReport {
+  LogLayout layout;
+  std::map<std::string, int64_t> channels;  // events per channel
+  int64_t depth_events = 0;
+  int64_t integrated = 0;
+  int64_t rejected = 0;   // decoded frames the integrator refused (reason in first_error)
+  int64_t malformed = 0;  // events that are not a valid depth_image_t or not a plausible frame
+  std::string first_error;
+  int64_t first_utime = -1;
+  int64_t last_utime = -1;
+  double integrate_s = 0.0;  // wall time spent in Mapper::integrate
+};
+
+// Integrates every frame of the log into `mapper`. Throws ReplayError (see scan_log).
+ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper);
+
+// Writes <dir>/map.ckpt (a checkpoint semx-mapper --checkpoint can start from), <dir>/map.bt
+// (OctoMap, octovis) and <dir>/map.pcd (occupied voxel centres, pcl_viewer), creating `dir`.
+// Returns the paths written; throws MapIoError naming the file on failure.
+std::vector<std::string> write_map_files(const Mapper& mapper, const std::string& dir, int64_t utime);
+
+}  // namespace semx::mapper

@@ -1,0 +1,127 @@
+// The mapper process around the Mapper library (docs/mapper.md, "Process"):
+//
+//   subscribes  CAMERA_DEPTH (depth_image_t), ODOMETRY (odometry_t), MAP_REQUEST (map_request_t)
+//   publishes   MAP_UPDATE   after every accepted frame (also when nothing changed), in the handler
+//               ESDF_LOCAL   after the frame's MAP_UPDATE, around the latest ODOMETRY position
+//                            (every frame, or every streaming.esdf_period)
+//               MAP_SNAPSHOT every streaming.snapshot_period and on MAP_REQUEST
+//               MAP_STATS    every streaming.stats_period
+//   writes      the checkpoint every checkpoint.period and on shutdown
+//
+// Everything runs on message time: the node's time is the latest SIM_CLOCK tick or frame utime,
+// and the periodic outputs are due by it, never by the wall clock. Depth frames are decoded and
+// checked by the subscription's accept predicate, so a frame that is not a frame counts as
+// malformed (NODE_STATUS) and changes nothing.
+//
+// Determinism in LOCKSTEP: the simulator publishes a tick's frames before SIM_CLOCK(k); the
+// handlers publish MAP_UPDATE/ESDF_LOCAL as they run and the periodic outputs run in the tick
+// handler, all before the Node acks k. MAP_REQUESTs received while following a LOCKSTEP clock are
+// answered in the next tick handler (so every run answers at the same tick); otherwise, or when
+// no tick comes within `request_grace_s` of wall time (the simulator ended), at once.
+#pragma once
+
+#include <semx/depth_image_t.hpp>
+#include <semx/map_request_t.hpp>
+#include <semx/odometry_t.hpp>
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "messages.hpp"
+#include "semx/mapper/mapper.hpp"
+#include "semx/runtime/node.hpp"
+
+namespace semx::mapper {
+
+struct MapperNodeOptions {
+  // Checkpoint file; empty: config.checkpoint.path. Loaded at construction when it exists.
+  std::string checkpoint_path;
+  // A checkpoint that exists but cannot be loaded: start with an empty map instead of failing
+  // (the bad file is renamed to <path>.bad so the next checkpoint does not destroy the evidence).
+  bool ignore_bad_checkpoint = false;
+  // Wall seconds a MAP_REQUEST may wait for the next lockstep tick before it is answered anyway.
+  double request_grace_s = 0.5;
+  bool quiet = false;  // no log lines for malformed or rejected frames
+};
+
+class MapperNode {
+ public:
+  struct Counters {
+    int64_t frames_received = 0;  // passed the subscription's checks (decoded, plausible)
+    int64_t frames_rejected = 0;  // of which refused by the integrator (e.g. no range overlap)
+    int64_t updates = 0;
+    int64_t esdfs = 0;
+    int64_t snapshots = 0;
+    int64_t requests = 0;
+    int64_t stats = 0;
+    int64_t checkpoints = 0;
+    int64_t checkpoint_errors = 0;
+    // Wall-clock cost, for the exit summary and monitoring only.
+    double integrate_ms = 0.0;  // total in Mapper::integrate
+    int64_t esdf_recomputes = 0;
+    double esdf_ms = 0.0;  // total in the ESDF recomputes
+  };
+
+  // Subscribes on `node` (which must outlive this) and loads the checkpoint when the file
+  // exists. Throws MapIoError (naming the file) for a checkpoint that cannot be loaded unless
+  // ignore_bad_checkpoint, and runtime::ConfigError for an invalid config or a checkpoint
+  // path whose directory does not exist.
+  MapperNode(runtime::Node& node, const MapperConfig& config, MapperNodeOptions options = {});
+
+  // Spins the node until shutdown, then writes a last checkpoint; returns the exit code.
+  int run();
+
+  // What a SIM_CLOCK tick triggers (public for tests): time moves to `utime`, pending requests
+  // are answered and the periodic outputs published when due.
+  void on_tick(int64_t tick, int64_t utime);
+  // Wall-clock liveness (run() calls it): answers a request that waited too long for a tick.
+  void poll_wall();
+  // Writes the checkpoint now if there is a path and the map changed since the last one.
+  bool checkpoint_now();
+
+  const Mapper& mapper() const { return mapper_; }
+  const Counters& counters() const { return counters_; }
+  // CAMERA_DEPTH messages dropped before the integrator: malformed bytes, content that is not a
+  // frame, or over the node's size limit (also in NODE_STATUS).
+  int64_t frames_malformed() const;
+  const std::string& checkpoint_path() const { return checkpoint_path_; }
+  // What happened to the checkpoint at start-up, for the log ("restored ...", "none yet", ...).
+  const std::string& startup_note() const { return startup_note_; }
+  int64_t now_utime() const { return now_; }
+
+ private:
+  bool accept_depth(const semx::depth_image_t& m);
+  void on_depth(const semx::depth_image_t& m);
+  void on_odometry(const semx::odometry_t& m);
+  void on_request(const semx::map_request_t& m);
+  void publish_snapshot();
+  void publish_stats();
+  void periodic();
+  void restore_checkpoint();
+  void update_state();
+
+  runtime::Node& node_;
+  Mapper mapper_;
+  MapperNodeOptions options_;
+  std::string checkpoint_path_;
+  std::string startup_note_;
+  Counters counters_;
+  DecodedDepth decoded_;  // written by accept_depth, read by on_depth right after
+  std::optional<Eigen::Vector3d> vehicle_;
+  int64_t now_ = 0;
+  bool have_time_ = false;
+  // Next due times (message time, us); -1: at the first opportunity.
+  int64_t next_stats_ = -1;
+  int64_t next_snapshot_ = -1;
+  int64_t next_esdf_ = -1;
+  int64_t next_checkpoint_ = -1;
+  int64_t checkpoint_seq_ = 0;  // map seq of the last checkpoint written or loaded (0: the empty map)
+  bool checkpoint_failing_ = false;
+  bool request_pending_ = false;
+  std::chrono::steady_clock::time_point request_since_;
+};
+
+}  // namespace semx::mapper

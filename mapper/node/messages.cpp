@@ -1,0 +1,308 @@
+#include "messages.hpp"
+
+#include <zlib.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "semx/mapper/voxel_key.hpp"
+
+namespace semx::mapper {
+
+namespace {
+
+bool finite3(const double v[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+// Positions further out than this are not a vehicle's (the integrator's own limit).
+constexpr double kMaxCoordinate = 1e5;
+
+}  // namespace
+
+// ---- CAMERA_DEPTH ----
+
+std::string decode_depth(const semx::depth_image_t& m, DecodedDepth& out) {
+  const semx::camera_info_t& info = m.info;
+  if (info.width <= 0 || info.height <= 0 ||
+      static_cast<int64_t>(info.width) * static_cast<int64_t>(info.height) > kMaxDepthPixels) {
+    return "camera size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
+           " is not positive or too large";
+  }
+  if (!(std::isfinite(info.fx) && std::isfinite(info.fy) && info.fx > 0 && info.fy > 0 &&
+        std::isfinite(info.cx) && std::isfinite(info.cy))) {
+    return "camera intrinsics are not finite and positive";
+  }
+  if (!(std::isfinite(info.min_range) && std::isfinite(info.max_range) && info.min_range >= 0 &&
+        info.max_range > info.min_range)) {
+    return "camera range limits are not 0 <= min_range < max_range";
+  }
+  if (!finite3(info.sensor_position)) return "sensor position is not finite";
+  for (double p : info.sensor_position) {
+    if (std::abs(p) > kMaxCoordinate) return "sensor position is beyond 1e5 m";
+  }
+  const double* q = info.sensor_orientation;
+  if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]) && std::isfinite(q[3]))) {
+    return "sensor orientation is not finite";
+  }
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(std::abs(norm - 1.0) <= 1e-3)) return "sensor orientation is not a unit quaternion";
+
+  const size_t pixels = static_cast<size_t>(info.width) * static_cast<size_t>(info.height);
+  const size_t bytes = pixels * 2;
+  if (m.num_depth_bytes < 0 || m.depth_data.size() != static_cast<size_t>(m.num_depth_bytes)) {
+    return "num_depth_bytes disagrees with the payload";
+  }
+  out.pixels.resize(pixels);
+  if (m.compression == semx::depth_image_t::NONE) {
+    if (m.depth_data.size() != bytes) {
+      return "payload has " + std::to_string(m.depth_data.size()) + " bytes, expected " +
+             std::to_string(bytes);
+    }
+    const uint8_t* d = m.depth_data.data();
+    for (size_t i = 0; i < pixels; ++i) out.pixels[i] = static_cast<uint16_t>(d[2 * i] | (d[2 * i + 1] << 8));
+  } else if (m.compression == semx::depth_image_t::ZLIB) {
+    // Inflate straight into the pixel buffer (little-endian bytes; converted below if needed).
+    uLongf size = static_cast<uLongf>(bytes);
+    const int rc = uncompress(reinterpret_cast<Bytef*>(out.pixels.data()), &size, m.depth_data.data(),
+                              static_cast<uLong>(m.depth_data.size()));
+    if (rc != Z_OK || size != bytes) {
+      return rc == Z_BUF_ERROR ? "zlib payload inflates to more than width*height*2 bytes or is truncated"
+                               : (rc == Z_OK ? "zlib payload inflates to " + std::to_string(size) +
+                                                   " bytes, expected " + std::to_string(bytes)
+                                             : "zlib payload is corrupt");
+    }
+    const uint16_t probe = 1;
+    if (*reinterpret_cast<const uint8_t*>(&probe) != 1) {  // big-endian host: swap to host order
+      for (uint16_t& p : out.pixels) p = static_cast<uint16_t>((p >> 8) | (p << 8));
+    }
+  } else {
+    return "unknown compression " + std::to_string(m.compression);
+  }
+
+  out.utime = m.utime;
+  out.frame_id = info.frame_id;
+  out.camera.width = info.width;
+  out.camera.height = info.height;
+  out.camera.fx = info.fx;
+  out.camera.fy = info.fy;
+  out.camera.cx = info.cx;
+  out.camera.cy = info.cy;
+  out.camera.min_range = info.min_range;
+  out.camera.max_range = info.max_range;
+  const Eigen::Quaterniond rot(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+  out.T_world_optical = Eigen::Isometry3d::Identity();
+  out.T_world_optical.linear() = rot.toRotationMatrix();
+  out.T_world_optical.translation() =
+      Eigen::Vector3d(info.sensor_position[0], info.sensor_position[1], info.sensor_position[2]);
+  return {};
+}
+
+semx::depth_image_t depth_message(const DepthFrame& f, bool compress, int64_t frame_id) {
+  semx::depth_image_t m{};
+  m.utime = f.utime;
+  semx::camera_info_t& info = m.info;
+  info.frame_id = frame_id;
+  const Eigen::Vector3d t = f.T_world_optical.translation();
+  const Eigen::Quaterniond q(f.T_world_optical.linear());
+  for (int i = 0; i < 3; ++i) info.sensor_position[i] = t[i];
+  info.sensor_orientation[0] = q.w();
+  info.sensor_orientation[1] = q.x();
+  info.sensor_orientation[2] = q.y();
+  info.sensor_orientation[3] = q.z();
+  info.width = f.camera.width;
+  info.height = f.camera.height;
+  info.fx = f.camera.fx;
+  info.fy = f.camera.fy;
+  info.cx = f.camera.cx;
+  info.cy = f.camera.cy;
+  info.min_range = f.camera.min_range;
+  info.max_range = f.camera.max_range;
+  std::vector<uint8_t> raw(f.depth_size * 2);
+  for (size_t i = 0; i < f.depth_size; ++i) {
+    raw[2 * i] = static_cast<uint8_t>(f.depth[i] & 0xFF);
+    raw[2 * i + 1] = static_cast<uint8_t>(f.depth[i] >> 8);
+  }
+  m.compression = semx::depth_image_t::NONE;
+  if (compress) {
+    uLongf size = compressBound(static_cast<uLong>(raw.size()));
+    std::vector<uint8_t> z(size);
+    if (compress2(z.data(), &size, raw.data(), static_cast<uLong>(raw.size()), 1) == Z_OK) {
+      z.resize(size);
+      raw.swap(z);
+      m.compression = semx::depth_image_t::ZLIB;
+    }
+  }
+  m.depth_data = std::move(raw);
+  m.num_depth_bytes = static_cast<int32_t>(m.depth_data.size());
+  return m;
+}
+
+// ---- MAP_UPDATE ----
+
+semx::map_update_t to_message(const MapDelta& d) {
+  semx::map_update_t m{};
+  m.utime = d.utime;
+  m.seq = d.seq;
+  m.resolution = d.resolution;
+  const size_t n = d.changes.size();
+  m.num_voxels = static_cast<int32_t>(n);
+  m.key_x.resize(n);
+  m.key_y.resize(n);
+  m.key_z.resize(n);
+  m.state.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const VoxelChange& c = d.changes[i];
+    m.key_x[i] = c.key.x;
+    m.key_y[i] = c.key.y;
+    m.key_z[i] = c.key.z;
+    m.state[i] = static_cast<int8_t>(c.state);
+  }
+  return m;
+}
+
+bool accept_update(const semx::map_update_t& m) {
+  if (m.num_voxels < 0) return false;
+  const size_t n = static_cast<size_t>(m.num_voxels);
+  if (m.key_x.size() != n || m.key_y.size() != n || m.key_z.size() != n || m.state.size() != n) return false;
+  if (!(std::isfinite(m.resolution) && m.resolution > 0)) return false;
+  for (int8_t s : m.state) {
+    if (!valid_state_value(s)) return false;
+  }
+  return true;
+}
+
+bool from_message(const semx::map_update_t& m, MapDelta& out) {
+  if (!accept_update(m)) return false;
+  out.seq = m.seq;
+  out.utime = m.utime;
+  out.resolution = m.resolution;
+  const size_t n = static_cast<size_t>(m.num_voxels);
+  out.changes.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    out.changes[i].key = VoxelKey(m.key_x[i], m.key_y[i], m.key_z[i]);
+    out.changes[i].state = static_cast<VoxelState>(m.state[i]);
+  }
+  return true;
+}
+
+// ---- MAP_SNAPSHOT ----
+
+semx::map_snapshot_t to_message(const MapSnapshot& s) {
+  semx::map_snapshot_t m{};
+  m.utime = s.utime;
+  m.seq = s.seq;
+  m.resolution = s.resolution;
+  m.encoding = s.encoding;
+  m.snapshot_data = s.data;
+  m.num_snapshot_bytes = static_cast<int32_t>(s.data.size());
+  return m;
+}
+
+MapSnapshot from_message(const semx::map_snapshot_t& m) {
+  MapSnapshot s;
+  s.utime = m.utime;
+  s.seq = m.seq;
+  s.resolution = m.resolution;
+  s.encoding = m.encoding;
+  s.data = m.snapshot_data;
+  return s;
+}
+
+bool accept_snapshot(const semx::map_snapshot_t& m) {
+  return m.num_snapshot_bytes >= 0 && m.snapshot_data.size() == static_cast<size_t>(m.num_snapshot_bytes) &&
+         std::isfinite(m.resolution) && m.resolution > 0 && m.seq >= 0;
+}
+
+// ---- MAP_REQUEST ----
+
+semx::map_request_t request_message(const std::string& requester, int64_t last_seq, int64_t utime) {
+  semx::map_request_t m{};
+  m.utime = utime;
+  m.requester = requester;
+  m.last_seq = last_seq;
+  return m;
+}
+
+bool accept_request(const semx::map_request_t& m) { return m.last_seq >= -1; }
+
+// ---- MAP_STATS ----
+
+semx::map_stats_t to_message(const MapStats& s, int64_t utime) {
+  semx::map_stats_t m{};
+  m.utime = utime;
+  m.seq = s.seq;
+  m.resolution = s.resolution;
+  m.free_voxels = s.free_voxels;
+  m.occupied_voxels = s.occupied_voxels;
+  m.frontier_voxels = s.frontier_voxels;
+  m.known_m3 = s.known_m3;
+  m.free_m3 = s.free_m3;
+  m.occupied_m3 = s.occupied_m3;
+  for (int i = 0; i < 3; ++i) {
+    m.bounds_min[i] = s.bounds_min[i];
+    m.bounds_max[i] = s.bounds_max[i];
+  }
+  m.frames_integrated = s.frames_integrated;
+  m.frames_rejected = s.frames_rejected;
+  m.integrate_ms = s.integrate_ms;
+  return m;
+}
+
+// ---- ESDF_LOCAL ----
+
+semx::esdf_local_t to_message(const EsdfGrid& g, int64_t utime) {
+  semx::esdf_local_t m{};
+  m.utime = utime;
+  m.map_seq = g.map_seq;
+  m.resolution = g.resolution;
+  const Eigen::Vector3d o = g.origin_point();
+  for (int i = 0; i < 3; ++i) m.origin[i] = o[i];
+  m.nx = g.nx;
+  m.ny = g.ny;
+  m.nz = g.nz;
+  m.unknown_as_occupied = g.unknown_as_occupied ? 1 : 0;
+  m.max_distance = g.max_distance;
+  m.distance = g.distance;
+  m.num_cells = static_cast<int32_t>(g.distance.size());
+  return m;
+}
+
+bool from_message(const semx::esdf_local_t& m, EsdfGrid& out) {
+  if (m.nx <= 0 || m.ny <= 0 || m.nz <= 0) return false;
+  const int64_t cells = static_cast<int64_t>(m.nx) * m.ny * m.nz;
+  if (cells != m.num_cells || m.distance.size() != static_cast<size_t>(cells)) return false;
+  if (!(std::isfinite(m.resolution) && m.resolution > 0 && std::isfinite(m.max_distance) &&
+        finite3(m.origin))) {
+    return false;
+  }
+  VoxelKey origin;
+  for (int i = 0; i < 3; ++i) {
+    const double k = std::round(m.origin[i] / m.resolution);
+    if (!(std::abs(k) < kMaxKeyMagnitude)) return false;
+    origin[i] = static_cast<int32_t>(k);
+  }
+  for (float d : m.distance) {
+    if (!std::isfinite(d)) return false;
+  }
+  out.resolution = m.resolution;
+  out.origin = origin;
+  out.nx = m.nx;
+  out.ny = m.ny;
+  out.nz = m.nz;
+  out.max_distance = m.max_distance;
+  out.unknown_as_occupied = m.unknown_as_occupied != 0;
+  out.map_seq = m.map_seq;
+  out.distance = m.distance;
+  return true;
+}
+
+// ---- ODOMETRY ----
+
+bool accept_odometry(const semx::odometry_t& m) {
+  if (!finite3(m.position)) return false;
+  for (double p : m.position) {
+    if (std::abs(p) > kMaxCoordinate) return false;
+  }
+  return true;
+}
+
+}  // namespace semx::mapper

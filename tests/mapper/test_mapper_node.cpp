@@ -1,0 +1,499 @@
+// The mapper process's node over memq://: what it publishes for each frame and tick, how it
+// treats hostile frames, snapshot requests, lockstep ordering and checkpoints.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <zlib.h>
+#include <semx/ack_t.hpp>
+#include <semx/clock_t.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mapper_node.hpp"
+#include "mapper_test_util.hpp"
+#include "messages.hpp"
+#include "semx/runtime/channels.hpp"
+
+namespace semx::mapper {
+namespace {
+
+namespace ch = semx::channels;
+
+runtime::NodeOptions memq_node(const std::string& name = "mapper", bool lockstep = false) {
+  runtime::NodeOptions o;
+  o.name = name;
+  o.lcm_url = "memq://";
+  o.quiet = true;
+  o.status_period_s = 1e6;
+  o.lockstep = lockstep;
+  return o;
+}
+
+MapperConfig small_config() {
+  MapperConfig c;
+  c.esdf.window = {4.0, 4.0, 2.0};  // 40 x 40 x 20 voxels: fast, and still a real field
+  c.streaming.snapshot_period = 0;  // only on request, unless a test says otherwise
+  c.streaming.stats_period = 1.0;
+  return c;
+}
+
+// Every message the node handles (its own and the test's), in order.
+struct Wire {
+  std::vector<std::string> channels;
+  std::vector<std::vector<uint8_t>> payloads;
+
+  explicit Wire(runtime::Node& node) {
+    node.subscribe_raw(".*", [this](const std::string& c, const uint8_t* d, std::size_t n) {
+      channels.push_back(c);
+      payloads.emplace_back(d, d + n);
+    });
+  }
+  template <class T>
+  std::vector<T> all(const std::string& channel) const {
+    std::vector<T> out;
+    for (size_t i = 0; i < channels.size(); ++i) {
+      if (channels[i] != channel) continue;
+      T m;
+      EXPECT_EQ(m.decode(payloads[i].data(), 0, static_cast<int>(payloads[i].size())),
+                static_cast<int>(payloads[i].size()));
+      out.push_back(m);
+    }
+    return out;
+  }
+  int count(const std::string& channel) const {
+    return static_cast<int>(std::count(channels.begin(), channels.end(), channel));
+  }
+  int index_of(const std::string& channel, int nth = 0) const {
+    for (size_t i = 0; i < channels.size(); ++i) {
+      if (channels[i] == channel && nth-- == 0) return static_cast<int>(i);
+    }
+    return -1;
+  }
+};
+
+semx::depth_image_t frame_message(const runtime::PinholeCamera& cam, const test::RoomFrame& f, int64_t utime,
+                                  bool compress = false) {
+  return depth_message(DepthFrame::view(cam, f.pose, f.depth, utime), compress);
+}
+
+semx::odometry_t odometry_at(const Eigen::Vector3d& p, int64_t utime) {
+  semx::odometry_t m{};
+  m.utime = utime;
+  for (int i = 0; i < 3; ++i) m.position[i] = p[i];
+  m.orientation[0] = 1.0;
+  return m;
+}
+
+semx::clock_t clock_at(int64_t tick, int64_t utime, bool lockstep) {
+  semx::clock_t c{};
+  c.tick = tick;
+  c.utime = utime;
+  c.mode = lockstep ? semx::clock_t::LOCKSTEP : semx::clock_t::REALTIME;
+  c.period_us = 10000;
+  return c;
+}
+
+std::string temp_file(const std::string& name) {
+  return ::testing::TempDir() + "semx_mnode_" + std::to_string(getpid()) + "_" + name;
+}
+
+void expect_same(const StateGrid& a, const StateGrid& b) {
+  VoxelKey diff;
+  EXPECT_TRUE(a.same_states(b, &diff)) << "first difference at " << diff.x << " " << diff.y << " " << diff.z;
+  EXPECT_EQ(a.free_voxels(), b.free_voxels());
+  EXPECT_EQ(a.occupied_voxels(), b.occupied_voxels());
+}
+
+TEST(MapperNode, PublishesTheMappersDeltaAndEsdfForEveryFrameAndStatsAt1Hz) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(5, cam, 5);
+  const MapperConfig cfg = small_config();
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  Mapper reference(cfg);
+
+  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
+  std::vector<MapDelta> expected;
+  std::vector<std::vector<float>> expected_esdf;
+  for (int k = 0; k < 5; ++k) {
+    const int64_t utime = k * 33333;
+    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k], utime, /*compress=*/k % 2 == 1));
+    node.drain();
+    expected.push_back(
+        reference.integrate(DepthFrame::view(cam, frames[k].pose, frames[k].depth, utime)).delta);
+    reference.update_esdf(vehicle);
+    expected_esdf.push_back(reference.esdf().distance);
+  }
+
+  const auto updates = wire.all<semx::map_update_t>(ch::MAP_UPDATE);
+  ASSERT_EQ(updates.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    MapDelta got;
+    ASSERT_TRUE(from_message(updates[k], got));
+    EXPECT_EQ(got.seq, k + 1);
+    EXPECT_EQ(got.seq, expected[k].seq);
+    EXPECT_EQ(got.utime, k * 33333);
+    EXPECT_EQ(got.resolution, 0.1);
+    ASSERT_EQ(got.changes.size(), expected[k].changes.size()) << "frame " << k;
+    EXPECT_GT(got.changes.size(), 0u);
+    for (size_t i = 0; i < got.changes.size(); ++i) {
+      ASSERT_EQ(got.changes[i].key, expected[k].changes[i].key);
+      ASSERT_EQ(got.changes[i].state, expected[k].changes[i].state);
+    }
+  }
+
+  const auto esdfs = wire.all<semx::esdf_local_t>(ch::ESDF_LOCAL);
+  ASSERT_EQ(esdfs.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    const auto& e = esdfs[k];
+    EXPECT_EQ(e.nx, 40);
+    EXPECT_EQ(e.ny, 40);
+    EXPECT_EQ(e.nz, 20);
+    EXPECT_EQ(e.num_cells, 40 * 40 * 20);
+    EXPECT_EQ(e.map_seq, k + 1);
+    EXPECT_EQ(e.utime, k * 33333);
+    EXPECT_TRUE(e.unknown_as_occupied);
+    // Centred on the odometry position, not on the camera.
+    EXPECT_NEAR(e.origin[0] + 0.5 * e.nx * e.resolution, vehicle.x(), 0.1);
+    EXPECT_NEAR(e.origin[1] + 0.5 * e.ny * e.resolution, vehicle.y(), 0.1);
+    EXPECT_NEAR(e.origin[2] + 0.5 * e.nz * e.resolution, vehicle.z(), 0.1);
+    EXPECT_EQ(e.distance, expected_esdf[k]) << "frame " << k;
+  }
+  // The message converts back into the same field (origin key, layout, queries).
+  EsdfGrid g;
+  ASSERT_TRUE(from_message(esdfs.back(), g));
+  EXPECT_EQ(g.origin, reference.esdf().origin);
+  for (const Eigen::Vector3d& p : {vehicle, Eigen::Vector3d(2.2, 1.9, 0.8), Eigen::Vector3d(4.1, 3.3, 1.9)}) {
+    double d = 0, d_ref = 1;
+    Eigen::Vector3d grad, grad_ref;
+    ASSERT_TRUE(g.interpolate(p, &d, &grad));
+    ASSERT_TRUE(reference.esdf().interpolate(p, &d_ref, &grad_ref));
+    EXPECT_EQ(d, d_ref);
+    EXPECT_EQ(grad, grad_ref);
+  }
+  // Each frame's MAP_UPDATE comes before its ESDF_LOCAL.
+  for (int k = 0; k < 5; ++k) EXPECT_LT(wire.index_of(ch::MAP_UPDATE, k), wire.index_of(ch::ESDF_LOCAL, k));
+
+  // MAP_STATS: once at the start, then every second of message time (ticks here).
+  EXPECT_EQ(wire.count(ch::MAP_STATS), 1);
+  for (int64_t t = 1; t <= 4; ++t) node.publish(ch::SIM_CLOCK, clock_at(t, t * 500000, false));
+  node.drain();
+  const auto stats = wire.all<semx::map_stats_t>(ch::MAP_STATS);
+  ASSERT_EQ(stats.size(), 3u) << "t = 0, 1.0 and 2.0 s";
+  EXPECT_EQ(stats[1].utime, 1000000);
+  EXPECT_EQ(stats[2].utime, 2000000);
+  const MapStats ref = reference.stats();
+  EXPECT_EQ(stats[2].seq, 5);
+  EXPECT_EQ(stats[2].free_voxels, ref.free_voxels);
+  EXPECT_EQ(stats[2].occupied_voxels, ref.occupied_voxels);
+  EXPECT_EQ(stats[2].frontier_voxels, ref.frontier_voxels);
+  EXPECT_DOUBLE_EQ(stats[2].known_m3, ref.known_m3);
+  EXPECT_EQ(stats[2].frames_integrated, 5);
+  EXPECT_EQ(stats[2].frames_rejected, 0);
+  expect_same(mn.mapper().map().grid(), reference.map().grid());
+  EXPECT_EQ(node.counters().malformed, 0);
+}
+
+TEST(MapperNode, EmptyDeltasArePublishedToo) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(1, cam, 1);
+  MapperConfig cfg = small_config();
+  cfg.esdf.enabled = false;
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  // The same view over and over: after the log-odds saturate nothing changes state.
+  for (int k = 0; k < 12; ++k) node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[0], k * 33333));
+  node.drain();
+  const auto updates = wire.all<semx::map_update_t>(ch::MAP_UPDATE);
+  ASSERT_EQ(updates.size(), 12u);
+  EXPECT_EQ(updates.back().seq, 12);
+  EXPECT_EQ(updates.back().num_voxels, 0);
+  EXPECT_EQ(wire.count(ch::ESDF_LOCAL), 0) << "esdf.enabled = false";
+}
+
+TEST(MapperNode, HostileAndMalformedFramesAreCountedAndDropped) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(1, cam, 1);
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNodeOptions quiet;
+  quiet.quiet = true;
+  MapperNode mn(node, small_config(), quiet);
+  const semx::depth_image_t good = frame_message(cam, frames[0], 1000);
+
+  std::vector<std::pair<std::string, semx::depth_image_t>> bad;
+  auto variant = [&](const char* what, const std::function<void(semx::depth_image_t&)>& edit) {
+    semx::depth_image_t m = good;
+    edit(m);
+    bad.emplace_back(what, m);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  variant("NaN position", [&](auto& m) { m.info.sensor_position[1] = nan; });
+  variant("infinite position", [&](auto& m) { m.info.sensor_position[0] = HUGE_VAL; });
+  variant("far position", [&](auto& m) { m.info.sensor_position[2] = 1e9; });
+  variant("NaN orientation", [&](auto& m) { m.info.sensor_orientation[0] = nan; });
+  variant("zero quaternion", [&](auto& m) {
+    for (double& q : m.info.sensor_orientation) q = 0;
+  });
+  variant("quaternion of norm 2", [&](auto& m) {
+    for (double& q : m.info.sensor_orientation) q *= 2;
+  });
+  variant("fx zero", [&](auto& m) { m.info.fx = 0; });
+  variant("fy negative", [&](auto& m) { m.info.fy = -80; });
+  variant("cx NaN", [&](auto& m) { m.info.cx = nan; });
+  variant("ranges inverted", [&](auto& m) { std::swap(m.info.min_range, m.info.max_range); });
+  variant("max range NaN", [&](auto& m) { m.info.max_range = nan; });
+  variant("width too small for the payload", [&](auto& m) { m.info.width = 100; });
+  variant("height zero", [&](auto& m) { m.info.height = 0; });
+  variant("negative width", [&](auto& m) { m.info.width = -160; });
+  variant("huge image", [&](auto& m) {
+    m.info.width = 1 << 15;
+    m.info.height = 1 << 15;
+  });
+  variant("payload one byte short", [&](auto& m) {
+    m.depth_data.pop_back();
+    m.num_depth_bytes = static_cast<int32_t>(m.depth_data.size());
+  });
+  variant("unknown compression", [&](auto& m) { m.compression = 7; });
+  variant("ZLIB flag on raw bytes", [&](auto& m) { m.compression = semx::depth_image_t::ZLIB; });
+  variant("zlib of the wrong size", [&](auto& m) {
+    std::vector<uint8_t> raw(m.depth_data.begin(), m.depth_data.end() - 2);
+    uLongf n = compressBound(raw.size());
+    std::vector<uint8_t> z(n);
+    compress2(z.data(), &n, raw.data(), raw.size(), 1);
+    z.resize(n);
+    m.depth_data = z;
+    m.num_depth_bytes = static_cast<int32_t>(z.size());
+    m.compression = semx::depth_image_t::ZLIB;
+  });
+  variant("zlib bomb", [&](auto& m) {
+    std::vector<uint8_t> raw(static_cast<size_t>(m.info.width) * m.info.height * 2 * 64, 0);
+    uLongf n = compressBound(raw.size());
+    std::vector<uint8_t> z(n);
+    compress2(z.data(), &n, raw.data(), raw.size(), 9);
+    z.resize(n);
+    m.depth_data = z;
+    m.num_depth_bytes = static_cast<int32_t>(z.size());
+    m.compression = semx::depth_image_t::ZLIB;
+  });
+  for (const auto& [what, m] : bad) node.publish(ch::CAMERA_DEPTH, m);
+  // Bytes that are not a depth_image_t at all: garbage, a truncated message, another type.
+  std::vector<uint8_t> bytes(good.getEncodedSize());
+  good.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  node.publish_raw(ch::CAMERA_DEPTH, bytes.data(), bytes.size() / 2);
+  const std::vector<uint8_t> garbage(1000, 0xA5);
+  node.publish_raw(ch::CAMERA_DEPTH, garbage.data(), garbage.size());
+  node.publish(ch::CAMERA_DEPTH, odometry_at(Eigen::Vector3d::Zero(), 0));
+  node.drain();
+
+  const int64_t n_bad = static_cast<int64_t>(bad.size()) + 3;
+  EXPECT_EQ(node.counters().malformed, n_bad);
+  EXPECT_EQ(mn.frames_malformed(), n_bad);
+  EXPECT_EQ(node.counters().handler_errors, 0);
+  EXPECT_EQ(mn.counters().frames_received, 0);
+  EXPECT_EQ(mn.mapper().seq(), 0);
+  EXPECT_EQ(mn.mapper().map().grid().known_voxels(), 0);
+  EXPECT_EQ(wire.count(ch::MAP_UPDATE), 0);
+  EXPECT_EQ(wire.count(ch::ESDF_LOCAL), 0);
+
+  // A frame the integrator refuses (its range does not overlap the mapper's 0-5 m): counted as
+  // rejected, no delta.
+  semx::depth_image_t far = good;
+  far.info.min_range = 6.0;
+  far.info.max_range = 9.0;
+  node.publish(ch::CAMERA_DEPTH, far);
+  node.drain();
+  EXPECT_EQ(mn.counters().frames_rejected, 1);
+  EXPECT_EQ(mn.mapper().seq(), 0);
+
+  // The node is intact: the good frame still goes through, and MAP_STATS counts the rest.
+  node.publish(ch::CAMERA_DEPTH, good);
+  node.publish(ch::SIM_CLOCK, clock_at(1, 2000000, false));
+  node.drain();
+  EXPECT_EQ(mn.mapper().seq(), 1);
+  ASSERT_EQ(wire.count(ch::MAP_UPDATE), 1);
+  const auto stats = wire.all<semx::map_stats_t>(ch::MAP_STATS);
+  ASSERT_FALSE(stats.empty());
+  EXPECT_EQ(stats.back().frames_integrated, 1);
+  EXPECT_EQ(stats.back().frames_rejected, n_bad + 1);
+  EXPECT_EQ(node.status().malformed, n_bad);
+}
+
+TEST(MapperNode, MapRequestIsAnsweredWithTheWholeMap) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(3, cam, 3);
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, small_config());
+  for (int k = 0; k < 3; ++k) node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k], k * 33333));
+  node.drain();
+  EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 0) << "snapshot_period 0: only on request";
+  node.publish(ch::MAP_REQUEST, request_message("planner", -1, 0));
+  node.drain();
+  const auto snaps = wire.all<semx::map_snapshot_t>(ch::MAP_SNAPSHOT);
+  ASSERT_EQ(snaps.size(), 1u);
+  EXPECT_EQ(snaps[0].seq, 3);
+  EXPECT_EQ(snaps[0].utime, 66666);
+  EXPECT_EQ(snaps[0].encoding, kSnapshotBlocksZlib);
+  StateGrid copy(0.1);
+  decode_snapshot(from_message(snaps[0]), copy);
+  expect_same(copy, mn.mapper().map().grid());
+  EXPECT_EQ(mn.counters().requests, 1);
+
+  // A request that is not a request (last_seq below -1) is malformed, not answered.
+  node.publish(ch::MAP_REQUEST, request_message("planner", -7, 0));
+  node.drain();
+  EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 1);
+  EXPECT_EQ(node.counters().malformed, 1);
+}
+
+TEST(MapperNode, PeriodicSnapshotsFollowMessageTime) {
+  MapperConfig cfg = small_config();
+  cfg.streaming.snapshot_period = 2.0;
+  cfg.streaming.stats_period = 0;  // off
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  for (int64_t t = 0; t <= 500; ++t) node.publish(ch::SIM_CLOCK, clock_at(t, t * 10000, false));
+  node.drain();
+  const auto snaps = wire.all<semx::map_snapshot_t>(ch::MAP_SNAPSHOT);
+  ASSERT_EQ(snaps.size(), 3u) << "t = 0, 2 and 4 s";
+  EXPECT_EQ(snaps[1].utime, 2000000);
+  EXPECT_EQ(snaps[2].utime, 4000000);
+  EXPECT_EQ(wire.count(ch::MAP_STATS), 0);
+}
+
+// In LOCKSTEP the node's outputs for tick k are on the wire before its SIM_ACK(k), and a
+// MAP_REQUEST is answered at the next tick, so every run answers at the same point.
+TEST(MapperNode, LockstepOutputsPrecedeTheAckAndRequestsWaitForTheNextTick) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(2, cam, 2);
+  runtime::Node node(memq_node("mapper", /*lockstep=*/true));
+  Wire wire(node);
+  MapperNode mn(node, small_config());
+
+  node.publish(ch::ODOMETRY, odometry_at(Eigen::Vector3d(3, 2.5, 1.3), 0));
+  node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[0], 0));
+  node.publish(ch::SIM_CLOCK, clock_at(0, 0, true));
+  node.drain();
+  const int update = wire.index_of(ch::MAP_UPDATE), esdf = wire.index_of(ch::ESDF_LOCAL),
+            stats = wire.index_of(ch::MAP_STATS), ack = wire.index_of(ch::SIM_ACK);
+  ASSERT_GE(update, 0);
+  ASSERT_GE(esdf, 0);
+  ASSERT_GE(stats, 0);
+  ASSERT_GE(ack, 0);
+  EXPECT_LT(update, ack);
+  EXPECT_LT(esdf, ack);
+  EXPECT_LT(stats, ack);
+  EXPECT_EQ(wire.all<semx::ack_t>(ch::SIM_ACK)[0].tick, 0);
+
+  // A request between ticks: answered by the tick-1 handler, before SIM_ACK(1).
+  node.publish(ch::MAP_REQUEST, request_message("planner", -1, 0));
+  node.drain();
+  EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 0) << "held for the next tick";
+  node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[1], 10000));
+  node.publish(ch::SIM_CLOCK, clock_at(1, 10000, true));
+  node.drain();
+  const int snap = wire.index_of(ch::MAP_SNAPSHOT), ack1 = wire.index_of(ch::SIM_ACK, 1);
+  ASSERT_GE(snap, 0);
+  ASSERT_GE(ack1, 0);
+  EXPECT_LT(snap, ack1);
+  EXPECT_EQ(wire.all<semx::map_snapshot_t>(ch::MAP_SNAPSHOT)[0].seq, 2) << "includes the tick's frame";
+  EXPECT_EQ(wire.all<semx::map_snapshot_t>(ch::MAP_SNAPSHOT)[0].utime, 10000);
+}
+
+TEST(MapperNode, CheckpointsOnMessageTimeAndRestoresOnStart) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(4, cam, 4);
+  const std::string path = temp_file("periodic.ckpt");
+  std::remove(path.c_str());
+  MapperConfig cfg = small_config();
+  cfg.checkpoint.path = path;
+  cfg.checkpoint.period = 1.0;
+  int64_t seq_saved = 0;
+  {
+    runtime::Node node(memq_node());
+    MapperNode mn(node, cfg);
+    EXPECT_NE(mn.startup_note().find("no checkpoint"), std::string::npos) << mn.startup_note();
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[0], 0));
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[1], 500000));
+    node.drain();
+    EXPECT_FALSE(std::filesystem::exists(path)) << "the first checkpoint is a period after the start";
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[2], 1000000));
+    node.drain();
+    ASSERT_TRUE(std::filesystem::exists(path));
+    EXPECT_EQ(mn.counters().checkpoints, 1);
+    EXPECT_EQ(read_checkpoint_info(path).seq, 3);
+    EXPECT_EQ(read_checkpoint_info(path).utime, 1000000);
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[3], 1200000));
+    node.drain();
+    EXPECT_EQ(read_checkpoint_info(path).seq, 3) << "not yet due";
+    EXPECT_TRUE(mn.checkpoint_now()) << "what run() does on shutdown";
+    EXPECT_FALSE(mn.checkpoint_now()) << "nothing changed since";
+    EXPECT_EQ(read_checkpoint_info(path).seq, 4);
+    seq_saved = mn.mapper().seq();
+  }
+  // A restarted mapper continues from the file, with the sequence jump that makes clients resync.
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  EXPECT_NE(mn.startup_note().find("restored"), std::string::npos) << mn.startup_note();
+  EXPECT_EQ(mn.mapper().seq(), seq_saved + Mapper::kRestoreSequenceJump);
+  Mapper reference(cfg);
+  for (const auto& f : frames) reference.integrate(DepthFrame::view(cam, f.pose, f.depth));
+  expect_same(mn.mapper().map().grid(), reference.map().grid());
+  node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[0], 0));
+  node.drain();
+  ASSERT_EQ(wire.count(ch::MAP_UPDATE), 1);
+  EXPECT_EQ(wire.all<semx::map_update_t>(ch::MAP_UPDATE)[0].seq,
+            seq_saved + Mapper::kRestoreSequenceJump + 1);
+  std::remove(path.c_str());
+}
+
+TEST(MapperNode, BadCheckpointIsAnErrorNamingTheFileUnlessIgnored) {
+  const std::string path = temp_file("bad.ckpt");
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << "SEMXMAP this is not a checkpoint";
+  }
+  MapperConfig cfg = small_config();
+  MapperNodeOptions o;
+  o.checkpoint_path = path;
+  {
+    runtime::Node node(memq_node());
+    try {
+      MapperNode mn(node, cfg, o);
+      FAIL() << "a corrupt checkpoint must not be accepted";
+    } catch (const MapIoError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--ignore-bad-checkpoint"), std::string::npos) << e.what();
+    }
+  }
+  o.ignore_bad_checkpoint = true;
+  o.quiet = true;
+  runtime::Node node(memq_node());
+  MapperNode mn(node, cfg, o);
+  EXPECT_EQ(mn.mapper().seq(), 0);
+  EXPECT_NE(mn.startup_note().find("ignored"), std::string::npos) << mn.startup_note();
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_TRUE(std::filesystem::exists(path + ".bad")) << "kept aside, not overwritten";
+  std::remove((path + ".bad").c_str());
+
+  // A checkpoint in a directory that does not exist is a config error at start, not a
+  // failure half an hour later.
+  o.checkpoint_path = temp_file("no_such_dir") + "/map.ckpt";
+  runtime::Node node2(memq_node());
+  EXPECT_THROW(MapperNode(node2, cfg, o), runtime::ConfigError);
+}
+
+}  // namespace
+}  // namespace semx::mapper
