@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "semx/mapper/voxel_key.hpp"
+#include "semx/runtime/camera_info.hpp"
 
 namespace semx::mapper {
 
@@ -21,101 +22,23 @@ constexpr double kMaxCoordinate = 1e5;
 // ---- CAMERA_DEPTH ----
 
 std::string decode_depth(const semx::depth_image_t& m, DecodedDepth& out) {
-  const semx::camera_info_t& info = m.info;
-  if (info.width <= 0 || info.height <= 0 ||
-      static_cast<int64_t>(info.width) * static_cast<int64_t>(info.height) > kMaxDepthPixels) {
-    return "camera size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
-           " is not positive or too large";
-  }
-  if (!(std::isfinite(info.fx) && std::isfinite(info.fy) && info.fx > 0 && info.fy > 0 &&
-        std::isfinite(info.cx) && std::isfinite(info.cy))) {
-    return "camera intrinsics are not finite and positive";
-  }
-  if (!(std::isfinite(info.min_range) && std::isfinite(info.max_range) && info.min_range >= 0 &&
-        info.max_range > info.min_range)) {
-    return "camera range limits are not 0 <= min_range < max_range";
-  }
-  if (!finite3(info.sensor_position)) return "sensor position is not finite";
-  for (double p : info.sensor_position) {
-    if (std::abs(p) > kMaxCoordinate) return "sensor position is beyond 1e5 m";
-  }
-  const double* q = info.sensor_orientation;
-  if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]) && std::isfinite(q[3]))) {
-    return "sensor orientation is not finite";
-  }
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(std::abs(norm - 1.0) <= 1e-3)) return "sensor orientation is not a unit quaternion";
-
-  const size_t pixels = static_cast<size_t>(info.width) * static_cast<size_t>(info.height);
-  const size_t bytes = pixels * 2;
+  std::string why = runtime::from_camera_info(m.info, out.camera, out.T_world_optical);
+  if (!why.empty()) return why;
   if (m.num_depth_bytes < 0 || m.depth_data.size() != static_cast<size_t>(m.num_depth_bytes)) {
     return "num_depth_bytes disagrees with the payload";
   }
-  out.pixels.resize(pixels);
-  if (m.compression == semx::depth_image_t::NONE) {
-    if (m.depth_data.size() != bytes) {
-      return "payload has " + std::to_string(m.depth_data.size()) + " bytes, expected " +
-             std::to_string(bytes);
-    }
-    const uint8_t* d = m.depth_data.data();
-    for (size_t i = 0; i < pixels; ++i) out.pixels[i] = static_cast<uint16_t>(d[2 * i] | (d[2 * i + 1] << 8));
-  } else if (m.compression == semx::depth_image_t::ZLIB) {
-    // Inflate straight into the pixel buffer (little-endian bytes; converted below if needed).
-    uLongf size = static_cast<uLongf>(bytes);
-    const int rc = uncompress(reinterpret_cast<Bytef*>(out.pixels.data()), &size, m.depth_data.data(),
-                              static_cast<uLong>(m.depth_data.size()));
-    if (rc != Z_OK || size != bytes) {
-      return rc == Z_BUF_ERROR ? "zlib payload inflates to more than width*height*2 bytes or is truncated"
-                               : (rc == Z_OK ? "zlib payload inflates to " + std::to_string(size) +
-                                                   " bytes, expected " + std::to_string(bytes)
-                                             : "zlib payload is corrupt");
-    }
-    const uint16_t probe = 1;
-    if (*reinterpret_cast<const uint8_t*>(&probe) != 1) {  // big-endian host: swap to host order
-      for (uint16_t& p : out.pixels) p = static_cast<uint16_t>((p >> 8) | (p << 8));
-    }
-  } else {
-    return "unknown compression " + std::to_string(m.compression);
-  }
-
+  const size_t pixels = static_cast<size_t>(m.info.width) * static_cast<size_t>(m.info.height);
+  why = runtime::decode_u16_image(m.compression, m.depth_data, pixels, out.pixels);
+  if (!why.empty()) return why;
   out.utime = m.utime;
-  out.frame_id = info.frame_id;
-  out.camera.width = info.width;
-  out.camera.height = info.height;
-  out.camera.fx = info.fx;
-  out.camera.fy = info.fy;
-  out.camera.cx = info.cx;
-  out.camera.cy = info.cy;
-  out.camera.min_range = info.min_range;
-  out.camera.max_range = info.max_range;
-  const Eigen::Quaterniond rot(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
-  out.T_world_optical = Eigen::Isometry3d::Identity();
-  out.T_world_optical.linear() = rot.toRotationMatrix();
-  out.T_world_optical.translation() =
-      Eigen::Vector3d(info.sensor_position[0], info.sensor_position[1], info.sensor_position[2]);
+  out.frame_id = m.info.frame_id;
   return {};
 }
 
 semx::depth_image_t depth_message(const DepthFrame& f, bool compress, int64_t frame_id) {
   semx::depth_image_t m{};
   m.utime = f.utime;
-  semx::camera_info_t& info = m.info;
-  info.frame_id = frame_id;
-  const Eigen::Vector3d t = f.T_world_optical.translation();
-  const Eigen::Quaterniond q(f.T_world_optical.linear());
-  for (int i = 0; i < 3; ++i) info.sensor_position[i] = t[i];
-  info.sensor_orientation[0] = q.w();
-  info.sensor_orientation[1] = q.x();
-  info.sensor_orientation[2] = q.y();
-  info.sensor_orientation[3] = q.z();
-  info.width = f.camera.width;
-  info.height = f.camera.height;
-  info.fx = f.camera.fx;
-  info.fy = f.camera.fy;
-  info.cx = f.camera.cx;
-  info.cy = f.camera.cy;
-  info.min_range = f.camera.min_range;
-  info.max_range = f.camera.max_range;
+  m.info = runtime::to_camera_info(f.camera, f.T_world_optical, frame_id);
   std::vector<uint8_t> raw(f.depth_size * 2);
   for (size_t i = 0; i < f.depth_size; ++i) {
     raw[2 * i] = static_cast<uint8_t>(f.depth[i] & 0xFF);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/runtime/camera_info.hpp"
 #include "semx/mapper/depth_frame.hpp"
 #include "semx/mapper/esdf_grid.hpp"
 #include "semx/mapper/map_delta.hpp"
@@ -29,9 +30,10 @@ namespace semx::mapper {
 
 // ---- CAMERA_DEPTH (depth_image_t) ----
 
-// Largest depth image accepted: 2^24 pixels (32 MiB of raw depth), checked before anything is
-// decompressed, so a small zlib bomb cannot make the mapper allocate gigabytes.
-inline constexpr int64_t kMaxDepthPixels = int64_t{1} << 24;
+// Largest depth image accepted: runtime::kMaxCameraPixels (2^24 pixels, 32 MiB of raw depth),
+// checked before anything is decompressed, so a small zlib bomb cannot make the mapper allocate
+// gigabytes.
+inline constexpr int64_t kMaxDepthPixels = runtime::kMaxCameraPixels;
 
 // A depth message decoded into pixels the frame can view.
 struct DecodedDepth {

@@ -32,7 +32,9 @@ std::optional<ClockTick> ClockServer::poll(double wall_s) {
   } else if (config_.mode == ClockMode::kRealtime) {
     due = wall_s >= start_wall_ + static_cast<double>(tick_ + 1) * config_.period_us * 1e-6 / config_.speed;
   } else {
-    due = tick_complete();
+    due = tick_complete() && (config_.max_speed <= 0 ||
+                              wall_s >= start_wall_ + static_cast<double>(tick_ + 1) * config_.period_us *
+                                                          1e-6 / config_.max_speed);
   }
   if (due) {
     ++tick_;

@@ -1,7 +1,9 @@
 #include "frame_messages.hpp"
 
 #include <cmath>
+
 #include <cstring>
+#include "semx/runtime/camera_info.hpp"
 
 namespace semx::simulator {
 
@@ -45,23 +47,7 @@ semx::imu_t to_message(const ImuSample& s) {
 }
 
 semx::camera_info_t camera_info(const CameraFrame& f) {
-  semx::camera_info_t info{};
-  info.frame_id = f.frame_id;
-  put_vec(info.sensor_position, f.pose.translation());
-  const Eigen::Quaterniond q(f.pose.linear());
-  info.sensor_orientation[0] = q.w();
-  info.sensor_orientation[1] = q.x();
-  info.sensor_orientation[2] = q.y();
-  info.sensor_orientation[3] = q.z();
-  info.width = f.camera.width;
-  info.height = f.camera.height;
-  info.fx = f.camera.fx;
-  info.fy = f.camera.fy;
-  info.cx = f.camera.cx;
-  info.cy = f.camera.cy;
-  info.min_range = f.camera.min_range;
-  info.max_range = f.camera.max_range;
-  return info;
+  return runtime::to_camera_info(f.camera, f.pose, f.frame_id);
 }
 
 semx::depth_image_t depth_message(const CameraFrame& f, runtime::ImageCompression codec) {
@@ -86,8 +72,8 @@ semx::rgb_image_t rgb_message(const CameraFrame& f, runtime::ImageCompression co
   m.info = camera_info(f);
   static_assert(sizeof(Rgb) == 3, "Rgb is three packed bytes");
   runtime::ImageCompression used;
-  m.rgb_data = runtime::encode_image(reinterpret_cast<const uint8_t*>(f.rgb.data.data()), f.rgb.data.size() * 3, 3,
-                                     codec, used);
+  m.rgb_data = runtime::encode_image(reinterpret_cast<const uint8_t*>(f.rgb.data.data()),
+                                     f.rgb.data.size() * 3, 3, codec, used);
   m.rgb_compression = static_cast<int8_t>(used);
   m.num_rgb_bytes = static_cast<int32_t>(m.rgb_data.size());
   return m;
@@ -120,7 +106,8 @@ semx::label_image_t label_message(const CameraFrame& f, runtime::ImageCompressio
 
 bool well_formed(const semx::control_cmd_t& m) {
   if (m.mode < semx::control_cmd_t::HOLD || m.mode > semx::control_cmd_t::ACCELERATION) return false;
-  if (m.yaw_mode != semx::control_cmd_t::YAW_ANGLE && m.yaw_mode != semx::control_cmd_t::YAW_RATE) return false;
+  if (m.yaw_mode != semx::control_cmd_t::YAW_ANGLE && m.yaw_mode != semx::control_cmd_t::YAW_RATE)
+    return false;
   for (double v : m.setpoint) {
     if (!std::isfinite(v)) return false;
   }

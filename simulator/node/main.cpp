@@ -13,28 +13,33 @@ int main(int argc, char** argv) {
     runtime::NodeFlags flags("simulator");
     std::string world = "env1", config_file, clock = "realtime", nodes;
     std::vector<std::string> sets;
-    double speed = 1.0, duration = 0, period_ms = 10, progress = 10;
+    double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10;
     bool compress = false, raw = false, no_rgb = false;
-    runtime::ArgParser p("semx-simulator",
-                         "Simulates the world, the quadrotor and its RGB-D, label and IMU sensors, and publishes\n"
-                         "them with SIM_CLOCK (docs/simulator.md).");
+    runtime::ArgParser p(
+        "semx-simulator",
+        "Simulates the world, the quadrotor and its RGB-D, label and IMU sensors, and publishes\n"
+        "them with SIM_CLOCK (docs/simulator.md).");
     flags.add_to(p);
     p.option("world", "FILE|NAME", "world file, or env1/env2/env3 (default env1)", &world)
         .option("config", "FILE", "simulator config YAML (docs/simulator.md)", &config_file)
         .repeated("set", "KEY=VALUE", "override a config key, e.g. --set camera.fx=400", &sets)
         .option("clock", "realtime|lockstep", "clock mode (default realtime)", &clock)
         .option("speed", "X", "realtime: simulated seconds per wall second (default 1)", &speed)
-        .option("lockstep-nodes", "A,B", "lockstep: nodes that must ack every tick (none: as fast as possible)",
-                &nodes)
+        .option("lockstep-nodes", "A,B",
+                "lockstep: nodes that must ack every tick (none: as fast as possible)", &nodes)
+        .option("max-speed", "X", "lockstep: at most X simulated seconds per wall second (default: no cap)",
+                &max_speed)
         .option("duration", "S", "end the episode after S simulated seconds (default: run until stopped)",
                 &duration)
-        .option("period-ms", "MS", "tick length in simulated ms (default 10, the odometry period)", &period_ms)
+        .option("period-ms", "MS", "tick length in simulated ms (default 10, the odometry period)",
+                &period_ms)
         .option("progress", "S", "simulated seconds between progress lines (0: none, default 10)", &progress)
         .flag("compress", "zlib-compress every image payload (smaller logs, slower)", &compress)
         .flag("raw-images", "send every image uncompressed (default: labels and RGB run-length coded)", &raw)
         .flag("no-rgb", "do not render or publish CAMERA_RGB", &no_rgb);
     if (!p.parse(argc, argv)) return 0;
-    if (clock != "realtime" && clock != "lockstep") throw runtime::ArgError("--clock: '" + clock + "' is not realtime or lockstep");
+    if (clock != "realtime" && clock != "lockstep")
+      throw runtime::ArgError("--clock: '" + clock + "' is not realtime or lockstep");
     if (!(period_ms > 0)) throw runtime::ArgError("--period-ms must be positive");
     if (!(speed > 0)) throw runtime::ArgError("--speed must be positive");
     if (duration < 0) throw runtime::ArgError("--duration must not be negative");
@@ -49,11 +54,13 @@ int main(int argc, char** argv) {
     o.clock.mode = clock == "lockstep" ? runtime::ClockMode::kLockstep : runtime::ClockMode::kRealtime;
     o.clock.period_us = static_cast<int64_t>(period_ms * 1000.0);
     o.clock.speed = speed;
+    o.clock.max_speed = max_speed;
     std::stringstream ss(nodes);
     for (std::string n; std::getline(ss, n, ',');) {
       if (!n.empty()) o.clock.lockstep_nodes.push_back(n);
     }
-    o.clock.max_ticks = duration > 0 ? static_cast<int64_t>(duration * 1e6 / static_cast<double>(o.clock.period_us)) + 1 : -1;
+    o.clock.max_ticks =
+        duration > 0 ? static_cast<int64_t>(duration * 1e6 / static_cast<double>(o.clock.period_us)) + 1 : -1;
     if (compress && raw) throw runtime::ArgError("--compress and --raw-images exclude each other");
     if (compress) o.depth_codec = o.label_codec = o.rgb_codec = runtime::ImageCompression::kZlib;
     if (raw) o.label_codec = o.rgb_codec = runtime::ImageCompression::kNone;
@@ -64,8 +71,8 @@ int main(int argc, char** argv) {
     node_options.follow_clock = false;  // it is the clock
     runtime::Node node(node_options);
     runtime::install_shutdown_handlers();
-    std::cout << "semx-simulator: world " << sim.world().name << " (" << path << "), " << clock << " clock on "
-              << node.url() << "\n";
+    std::cout << "semx-simulator: world " << sim.world().name << " (" << path << "), " << clock
+              << " clock on " << node.url() << "\n";
     return simulator::SimulatorNode(sim, node, o).run();
   });
 }

@@ -106,3 +106,18 @@ TEST(ClockServer, StopsAfterMaxTicks) {
   EXPECT_TRUE(s.finished());
   EXPECT_FALSE(s.poll(2));
 }
+
+TEST(ClockServer, LockstepCanBeCappedToASpeed) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"a"};
+  cfg.period_us = 10000;
+  cfg.max_speed = 2.0;  // at most 2 simulated s per wall s: a tick every 5 ms
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(10.0));
+  s.on_ack("a", 0);
+  EXPECT_FALSE(s.poll(10.004)) << "acked, but faster than the cap";
+  auto t = s.poll(10.005);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 1);
+}

@@ -56,7 +56,7 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
          "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
          "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
          "--ticks, \""
-      << kTicks << "\"]\n    ends_set: true\n    start_delay: 1.0\n";
+      << kTicks << "\", --max-speed, \"5\"]\n    ends_set: true\n    start_delay: 1.0\n";
   const std::string out = temp_path("lockstep.out");
   Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--grace", "3"}, out);
   ASSERT_EQ(launcher.wait(30), 0) << read_file(out);

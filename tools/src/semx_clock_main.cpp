@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   return run_main("semx-clock", [&] {
     NodeFlags flags("clock");
     std::string mode = "realtime", nodes;
-    double period_ms = 10, speed = 1, resend_s = 0.5, stall_warn_s = 5;
+    double period_ms = 10, speed = 1, max_speed = 0, resend_s = 0.5, stall_warn_s = 5;
     int64_t ticks = -1;
     ArgParser p("semx-clock",
                 "Publishes SIM_CLOCK. LOCKSTEP advances only when every --lockstep-nodes node acked.");
@@ -44,6 +44,8 @@ int main(int argc, char** argv) {
         .option("period-ms", "MS", "simulated milliseconds per tick (default 10)", &period_ms)
         .option("speed", "X", "REALTIME: simulated seconds per wall second (default 1)", &speed)
         .option("lockstep-nodes", "A,B", "LOCKSTEP: nodes that must ack every tick", &nodes)
+        .option("max-speed", "X", "LOCKSTEP: at most X simulated seconds per wall second (default: no cap)",
+                &max_speed)
         .option("ticks", "N", "exit after N ticks (default: run until stopped)", &ticks)
         .option("resend", "S", "LOCKSTEP: resend an unacked tick after S wall seconds (default 0.5)",
                 &resend_s)
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
     cfg.mode = mode == "lockstep" ? ClockMode::kLockstep : ClockMode::kRealtime;
     cfg.period_us = static_cast<int64_t>(period_ms * 1000.0);
     cfg.speed = speed;
+    cfg.max_speed = max_speed;
     cfg.lockstep_nodes = split_list(nodes);
     cfg.resend_after_s = resend_s;
     cfg.max_ticks = ticks;

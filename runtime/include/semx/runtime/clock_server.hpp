@@ -19,8 +19,9 @@ namespace semx::runtime {
 
 struct ClockServerConfig {
   ClockMode mode = ClockMode::kRealtime;
-  int64_t period_us = 10000;                // 100 Hz: the odometry rate
-  double speed = 1.0;                       // REALTIME only
+  int64_t period_us = 10000;  // 100 Hz: the odometry rate
+  double speed = 1.0;         // REALTIME only
+  double max_speed = 0.0;     // LOCKSTEP: never faster than this many simulated s per wall s (0: no cap)
   std::vector<std::string> lockstep_nodes;  // LOCKSTEP: who must ack every tick
   double resend_after_s = 0.5;
   int64_t max_ticks = -1;  // stop after this many ticks (-1: never)
