@@ -1,0 +1,133 @@
+// CoverageTracker: the incremental count equals a from-scratch count after random deltas,
+// snapshots (resets) and mirrors; resolution checks; full and empty maps.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <unordered_set>
+
+#include "evaluator_test_util.hpp"
+#include "semx/evaluator/coverage_tracker.hpp"
+#include "semx/mapper/map_mirror.hpp"
+#include "semx/mapper/map_snapshot.hpp"
+
+namespace semx::evaluator {
+namespace {
+
+std::shared_ptr<const simulator::GroundTruth> small_gt(double res = 0.1) {
+  return std::make_shared<const simulator::GroundTruth>(test::small_world(), res);
+}
+
+TEST(CoverageTracker, StartsEmptyWithTheGroundTruthsTargetSet) {
+  const auto gt = small_gt();
+  CoverageTracker t(gt);
+  EXPECT_GT(t.target_count(), 1000);
+  EXPECT_EQ(t.target_count(), static_cast<int64_t>(gt->target_count()));
+  EXPECT_EQ(t.covered(), 0);
+  EXPECT_EQ(t.coverage(), 0.0);
+  mapper::StateGrid empty(0.1);
+  EXPECT_EQ(CoverageTracker::count_covered(*gt, empty), 0);
+}
+
+TEST(CoverageTracker, IncrementalCountEqualsBruteForceOnRandomDeltas) {
+  const auto gt = small_gt();
+  CoverageTracker tracker(gt);
+  mapper::StateGrid grid(0.1);
+  std::mt19937 rng(12345);
+  // Keys in the ground truth's grid and 3 voxels around it (outside T).
+  const Eigen::Vector3i lo = gt->min_key() - Eigen::Vector3i::Constant(3);
+  const Eigen::Vector3i hi = gt->min_key() + gt->dims() + Eigen::Vector3i::Constant(2);
+  std::uniform_int_distribution<int> dx(lo.x(), hi.x()), dy(lo.y(), hi.y()), dz(lo.z(), hi.z());
+  std::uniform_int_distribution<int> state(0, 9);  // mostly known states, some back to unknown
+  for (int round = 0; round < 120; ++round) {
+    mapper::MapDelta d;
+    d.seq = round + 1;
+    d.utime = round * 100000;
+    d.resolution = 0.1;
+    std::unordered_set<mapper::VoxelKey> used;
+    const int n = 50 + static_cast<int>(rng() % 400);
+    for (int i = 0; i < n; ++i) {
+      const mapper::VoxelKey k(dx(rng), dy(rng), dz(rng));
+      if (!used.insert(k).second) continue;
+      const int s = state(rng);
+      const auto vs = s == 0 ? mapper::VoxelState::kUnknown
+                             : (s < 7 ? mapper::VoxelState::kFree : mapper::VoxelState::kOccupied);
+      d.changes.push_back({k, vs});
+      grid.set_state(k, vs);
+    }
+    ASSERT_TRUE(tracker.apply(d));
+    ASSERT_EQ(tracker.covered(), CoverageTracker::count_covered(*gt, grid)) << "after delta " << round;
+    if (round % 25 == 24) {
+      CoverageTracker fresh(gt);
+      ASSERT_TRUE(fresh.reset(grid));
+      EXPECT_EQ(fresh.covered(), tracker.covered());
+    }
+  }
+  EXPECT_GT(tracker.covered(), 0);
+  EXPECT_LT(tracker.covered(), tracker.target_count());
+}
+
+TEST(CoverageTracker, FollowsAMirrorThroughDeltasAndASnapshotAfterAGap) {
+  const auto gt = small_gt();
+  const auto deltas = test::sweep_deltas(*gt, 12, 0, 500000);
+  mapper::StateGrid truth(0.1);  // the mapper's map
+  mapper::MapMirror mirror(0.1);
+  CoverageTracker tracker(gt);
+  int64_t previous = 0;
+  for (const auto& d : deltas) {
+    for (const auto& c : d.changes) truth.set_state(c.key, c.state);
+    if (d.seq == 5) continue;  // lost
+    if (d.seq == 8) {
+      // The client asked; the mapper answers with a snapshot of its map at seq 8.
+      mirror.apply(d);  // buffered (gap)
+      ASSERT_TRUE(mirror.needs_snapshot());
+      ASSERT_EQ(mirror.apply(mapper::encode_snapshot(truth, 8, d.utime)),
+                mapper::MapMirror::SnapshotResult::kApplied);
+      ASSERT_TRUE(tracker.reset(mirror.grid()));
+    } else if (mirror.apply(d) == mapper::MapMirror::DeltaResult::kApplied) {
+      ASSERT_TRUE(tracker.apply(d));
+    }
+    if (mirror.needs_snapshot()) continue;
+    EXPECT_EQ(tracker.covered(), CoverageTracker::count_covered(*gt, mirror.grid())) << "seq " << d.seq;
+    EXPECT_GE(tracker.covered(), previous);
+    previous = tracker.covered();
+  }
+  // The whole sweep reveals every target voxel.
+  EXPECT_EQ(tracker.covered(), tracker.target_count());
+  EXPECT_DOUBLE_EQ(tracker.coverage(), 1.0);
+}
+
+TEST(CoverageTracker, RefusesAnotherResolution) {
+  const auto gt = small_gt();
+  CoverageTracker tracker(gt);
+  mapper::MapDelta d;
+  d.resolution = 0.2;
+  d.changes.push_back({mapper::VoxelKey(5, 5, 5), mapper::VoxelState::kFree});
+  EXPECT_FALSE(tracker.apply(d));
+  EXPECT_EQ(tracker.covered(), 0);
+  mapper::StateGrid g(0.2);
+  g.set_state({5, 5, 5}, mapper::VoxelState::kFree);
+  EXPECT_FALSE(tracker.reset(g));
+  EXPECT_TRUE(tracker.matches(0.1 + 1e-12));
+}
+
+TEST(CoverageTracker, CountsOnlyTargetVoxels) {
+  const auto gt = small_gt();
+  CoverageTracker tracker(gt);
+  // The start's voxel is reachable free; a voxel inside the floor slab's interior is not in T.
+  const Eigen::Vector3i start = gt->key_of({1.0, 1.2, 0.8});
+  ASSERT_TRUE(gt->in_target(start));
+  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kOccupied);
+  EXPECT_EQ(tracker.covered(), 1);
+  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kFree);  // still known
+  EXPECT_EQ(tracker.covered(), 1);
+  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kUnknown);
+  EXPECT_EQ(tracker.covered(), 0);
+  tracker.set({1000, 1000, 1000}, mapper::VoxelState::kFree);  // far outside the world
+  const Eigen::Vector3i wall_far_side = gt->key_of({1.5, -0.15, 0.8});
+  ASSERT_FALSE(gt->in_target(wall_far_side));
+  tracker.set({wall_far_side.x(), wall_far_side.y(), wall_far_side.z()}, mapper::VoxelState::kOccupied);
+  EXPECT_EQ(tracker.covered(), 0);
+}
+
+}  // namespace
+}  // namespace semx::evaluator

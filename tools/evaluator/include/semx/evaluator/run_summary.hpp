@@ -1,0 +1,50 @@
+// Everything a run folder records about one run: what was run (RunInfo), the paper's metrics
+// and the coverage over time. Built by Evaluation::summary(); written by run_folder.hpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "semx/evaluator/run_metrics.hpp"
+
+namespace semx::evaluator {
+
+// What was run, recorded as given on the command line (planner: from PLANNER_STATUS when empty).
+struct RunInfo {
+  std::string world;       // name (env1) or file stem
+  std::string world_path;  // the world file
+  std::string planner;     // semantic-dep, dep, aep, nbv, ...
+  std::optional<int64_t> seed;
+  std::optional<int64_t> samples;  // the planner's sampling density (paper Table II)
+  std::string source = "live";     // "live" (semx-evaluator) or "log" (semx-eval)
+};
+
+struct RunSummary {
+  RunInfo info;
+  // The paper's metrics.
+  double time_f_s = 0.0;
+  double distance_m = 0.0;
+  double coverage_pct = 0.0;
+  std::optional<double> time_r_s;  // null when the threshold was never reached
+  int64_t collisions = 0;
+  double wall_s = 0.0;  // wall-clock s from the first SIM_CLOCK, ODOMETRY or MAP_UPDATE to the end
+  // Context.
+  std::string termination;             // to_string(Termination)
+  std::string planner_state;           // last PLANNER_STATUS state, "none" if never heard
+  std::string planner_reason;          // its reason text
+  double sim_s = 0.0;                  // last message time, s
+  double realtime_factor = 0.0;        // sim_s / wall_s (0 when wall_s is 0)
+  std::optional<double> time_limit_s;  // null when none
+  double coverage_threshold_pct = 85.0;
+  double resolution_m = 0.0;
+  int64_t target_voxels = 0;
+  int64_t covered_voxels = 0;
+  int64_t map_seq = 0;  // last map sequence number applied
+  std::vector<CoverageSample> coverage;
+  std::vector<Eigen::Vector3d> trajectory;
+};
+
+}  // namespace semx::evaluator

@@ -1,0 +1,199 @@
+#include "evaluator_node.hpp"
+
+#include <semx/odometry_t.hpp>
+#include <semx/planner_status_t.hpp>
+#include <semx/sim_event_t.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+
+#include "semx/evaluator/map_picture.hpp"
+#include "semx/evaluator/run_folder.hpp"
+#include "semx/runtime/channels.hpp"
+
+namespace semx::evaluator {
+
+namespace ch = semx::channels;
+
+static_assert(semx::planner_status_t::DONE == static_cast<int>(PlannerState::kDone) &&
+                  semx::planner_status_t::FAILED == static_cast<int>(PlannerState::kFailed) &&
+                  semx::planner_status_t::INIT == static_cast<int>(PlannerState::kInit),
+              "PlannerState mirrors planner_status_t");
+
+namespace {
+
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+mapper::MapClientOptions client_options(const runtime::Node& node) {
+  mapper::MapClientOptions o;
+  o.resolution = 0;  // adopt the mapper's; the ground truth follows it
+  o.requester = node.name();
+  return o;
+}
+
+bool finite3(const double* v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+}  // namespace
+
+EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, EvaluatorNodeOptions options)
+    : node_(node),
+      options_(std::move(options)),
+      evaluation_(std::move(world), options_.evaluation),
+      map_(node_, client_options(node_)) {
+  map_.on_delta([this](const mapper::MapDelta& d) {
+    note_wall();
+    evaluation_.on_map_delta(d, map_.mirror().grid());
+    message_time(d.utime);
+  });
+  map_.on_reset([this] {
+    const int64_t t = std::max(node_.now_utime(), evaluation_.metrics().now_utime());
+    evaluation_.on_map_reset(map_.mirror().grid(), t, map_.seq());
+  });
+  node_.subscribe<semx::odometry_t>(
+      ch::ODOMETRY,
+      [this](const semx::odometry_t& m) {
+        note_wall();
+        message_time(m.utime);
+        evaluation_.on_odometry(m.utime, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]));
+      },
+      [](const semx::odometry_t& m) { return finite3(m.position); });
+  node_.subscribe<semx::sim_event_t>(ch::SIM_EVENT, [this](const semx::sim_event_t& m) {
+    if (m.type == semx::sim_event_t::EPISODE_END) {
+      // Everything of the last tick is in: apply what the map client still holds, then end.
+      map_.on_tick(node_.clock().last_tick() + 1, std::numeric_limits<int64_t>::max());
+      finish_at(Termination::kEpisodeEnd, m.utime);
+      return;
+    }
+    message_time(m.utime);
+    if (m.type == semx::sim_event_t::COLLISION) {
+      evaluation_.on_collision(m.utime, m.count);
+      if (options_.print) {
+        std::printf("semx-evaluator: COLLISION at t=%.2f s (%.2f, %.2f, %.2f), solid %d\n", m.utime * 1e-6,
+                    m.position[0], m.position[1], m.position[2], m.solid_index);
+        std::fflush(stdout);
+      }
+    }
+  });
+  node_.subscribe<semx::planner_status_t>(ch::PLANNER_STATUS, [this](const semx::planner_status_t& m) {
+    message_time(m.utime);
+    const PlannerState before = evaluation_.planner_state();
+    evaluation_.on_planner_status(m.utime, m.planner, planner_state_from_int(m.state), m.reason);
+    if (options_.print && before != PlannerState::kDone &&
+        evaluation_.planner_state() == PlannerState::kDone) {
+      std::printf("semx-evaluator: planner DONE at t=%.2f s%s%s\n", m.utime * 1e-6,
+                  m.reason.empty() ? "" : ": ", m.reason.c_str());
+      std::fflush(stdout);
+    }
+  });
+  node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  node_.set_state(runtime::NodeState::kRunning, "waiting for the simulation");
+}
+
+void EvaluatorNode::note_wall() {
+  if (wall_start_ < 0) wall_start_ = wall_now();
+}
+
+double EvaluatorNode::wall_s() const {
+  if (wall_start_ < 0) return 0.0;
+  return (wall_end_ >= 0 ? wall_end_ : wall_now()) - wall_start_;
+}
+
+void EvaluatorNode::on_tick(int64_t /*tick*/, int64_t utime) {
+  note_wall();
+  end_if_due(utime);
+  if (finished()) return;
+  evaluation_.advance(utime);
+  progress(utime);
+}
+
+void EvaluatorNode::message_time(int64_t utime) {
+  if (node_.clock().started() || finished()) return;
+  end_if_due(utime);
+  if (finished()) return;
+  evaluation_.advance(utime);
+  progress(utime);
+}
+
+void EvaluatorNode::end_if_due(int64_t utime) {
+  if (const auto why = evaluation_.due(utime)) finish_at(*why, utime);
+}
+
+void EvaluatorNode::progress(int64_t utime) {
+  if (!(options_.progress_s > 0)) return;
+  const double t = static_cast<double>(utime) * 1e-6;
+  if (t < next_progress_s_) return;
+  next_progress_s_ = (std::floor(t / options_.progress_s) + 1) * options_.progress_s;
+  const auto& m = evaluation_.metrics();
+  const std::string line = format_progress(t, m.coverage_pct(), m.distance_m(), to_string(m.planner_state()));
+  if (options_.print) {
+    std::printf("semx-evaluator: %s\n", line.c_str());
+    std::fflush(stdout);
+  }
+  node_.set_state(runtime::NodeState::kRunning, line);
+}
+
+void EvaluatorNode::finish_at(Termination why, int64_t utime) {
+  if (finished()) return;
+  wall_end_ = wall_now();
+  evaluation_.finish(why, utime, wall_s());
+  write_folder();
+  const RunSummary s = evaluation_.summary();
+  if (options_.print) {
+    std::printf("semx-evaluator: run ended (%s) at t=%.2f s\n%s", s.termination.c_str(), s.sim_s,
+                format_metrics_table(s).c_str());
+    if (!written_.empty()) {
+      std::printf("semx-evaluator: run folder %s\n", options_.out_dir.c_str());
+    }
+    std::fflush(stdout);
+  }
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "%s: coverage %.1f%%, Time_f %.1f s", s.termination.c_str(),
+                s.coverage_pct, s.time_f_s);
+  node_.set_state(write_failed_ ? runtime::NodeState::kFailed : runtime::NodeState::kDone, detail);
+  node_.stop();
+}
+
+bool EvaluatorNode::finish(Termination why) {
+  finish_at(why, std::max(node_.now_utime(), evaluation_.metrics().now_utime()));
+  return !write_failed_;
+}
+
+void EvaluatorNode::write_folder() {
+  if (options_.out_dir.empty()) return;
+  try {
+    const RunSummary s = evaluation_.summary();
+    written_ = write_run_metrics(options_.out_dir, s);
+    const mapper::StateGrid empty(evaluation_.tracker().resolution());
+    const mapper::StateGrid& grid = map_.has_mirror() ? map_.mirror().grid() : empty;
+    const std::string title = (s.info.world.empty() ? std::string("map") : s.info.world) +
+                              (s.info.planner.empty() ? "" : ", " + s.info.planner) + "  coverage " +
+                              std::to_string(static_cast<int>(std::floor(s.coverage_pct))) +
+                              " %, t=" + std::to_string(static_cast<int>(std::lround(s.time_f_s))) + " s";
+    const std::string png = (std::filesystem::path(options_.out_dir) / "map.png").string();
+    run_map_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.trajectory, title)
+        .write_png(png);
+    written_.push_back(png);
+  } catch (const std::exception& e) {
+    write_failed_ = true;
+    std::cerr << "semx-evaluator: " << e.what() << "\n";
+  }
+}
+
+int EvaluatorNode::run() {
+  while (!finished() && !node_.stopped()) {
+    if (node_.spin_once(100) < 0) {
+      std::cerr << "semx-evaluator: the LCM provider failed\n";
+      break;
+    }
+  }
+  if (!finished()) finish(Termination::kStopped);
+  return write_failed_ ? 1 : 0;
+}
+
+}  // namespace semx::evaluator
