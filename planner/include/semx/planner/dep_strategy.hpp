@@ -1,0 +1,93 @@
+// DEP: the incremental roadmap of the paper (§III-D, Fig. 3) with the semantic reward (semantic-dep)
+// or without it (dep).
+//
+// Each cycle:
+//  1. map changes since the last cycle: nodes within sensor range of a changed 16³ block get
+//     their gain marked stale; nodes and edges near voxels that became occupied or unknown are
+//     re-checked and removed when they collide (the roadmap never keeps a blocked edge);
+//  2. the vehicle's pose becomes the root node, connected to its k nearest nodes (root_edge_free);
+//     the previous root stays as an ordinary node when it is collision-free and not crowding
+//     another node;
+//  3. up to `samples` candidates are drawn (Sampler), each kept when node_free, at least
+//     min_node_distance from every node and connected by at least one collision-free edge to its
+//     k nearest nodes within max_edge_length;
+//  4. Dijkstra from the root gives each node its path length d;
+//  5. scores (G + R_sem) / T_path of the reachable nodes are ranked lazily: new nodes are
+//     evaluated, a stale node is re-evaluated only when its cached score is the best left (its
+//     gain can only have shrunk as the map filled in, up to frontier re-classification), so few
+//     gains are recomputed per cycle. Nodes with G < min_gain are not goals (the reward only
+//     ranks informative nodes), nor nodes that need neither a move nor a turn;
+//  6. the best node is the goal; its roadmap path, with yaws turning linearly in arc length to the
+//     goal's yaw, is the plan. The root itself may be the goal: a turn in place.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/gain_evaluator.hpp"
+#include "semx/planner/roadmap.hpp"
+#include "semx/planner/sampler.hpp"
+#include "semx/planner/strategy.hpp"
+
+namespace semx::planner {
+
+class DepStrategy : public Strategy {
+ public:
+  DepStrategy(const PlannerConfig& config, bool semantic);
+
+  void on_map_changes(const std::vector<mapper::VoxelChange>& changes) override;
+  void on_map_reset() override;
+  void on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) override;
+  PlanOutcome plan(PlanContext& ctx) override;
+  std::optional<double> goal_score(PlanContext& ctx, const Goal& goal) override;
+  void reject_goal(const Goal& goal, int64_t until_cycle) override;
+  bool receding_horizon() const override { return false; }
+  RoadmapView roadmap(const Goal* goal) const override;
+  void reset() override;
+
+  // ---- building blocks (AEP's global graph uses them too) ----
+  // Step 1: stale gains, pruning.
+  void process_map_changes(PlanContext& ctx);
+  // Step 2: returns the root's id.
+  int64_t insert_root(PlanContext& ctx);
+  // Step 3 for one position: the new node's id, or -1 when it was not kept.
+  int64_t try_insert(PlanContext& ctx, const Eigen::Vector3d& p);
+  // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
+  using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
+  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason);
+  // The paper's score (G + R_sem) / T_path (travel_cost.hpp).
+  ScoreFn paper_score() const;
+  void evaluate_gain(PlanContext& ctx, int64_t id);
+
+  const Roadmap& graph() const { return graph_; }
+  Roadmap& graph() { return graph_; }
+  int64_t root() const { return root_; }
+  CollisionChecker& checker() { return checker_; }
+  GainEvaluator& gains() { return gains_; }
+
+ private:
+  double score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const;
+  // Some voxel of obstacle_voxels_ has its centre within `radius` of the segment a-b.
+  bool obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double res) const;
+  bool nothing_to_do(PlanContext& ctx, int64_t id) const;
+
+  PlannerConfig config_;
+  bool semantic_;
+  CollisionChecker checker_;
+  GainEvaluator gains_;
+  Sampler sampler_;
+  Roadmap graph_;
+  int64_t root_ = -1;
+  std::set<mapper::VoxelKey> changed_blocks_;  // since the last cycle
+  // Voxels that became occupied or unknown since the last cycle, by block.
+  std::map<mapper::VoxelKey, std::vector<mapper::VoxelKey>> obstacle_voxels_;
+  bool full_reset_ = false;
+  // The last cycle's search and per-slot values, for goal_score() and the roadmap view.
+  Roadmap::Search search_;
+  std::vector<double> reward_, cost_, score_;
+};
+
+}  // namespace semx::planner

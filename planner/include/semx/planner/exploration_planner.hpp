@@ -1,0 +1,132 @@
+// The planner's main loop (paper Fig. 2, "Main Loop"): runs a planning method (strategy.hpp) on
+// message time, decides when to replan, charges planning time, and says when exploration is done.
+//
+//   ExplorationPlanner p(config);
+//   p.set_map(&mirror.grid());                  // and after every delta: p.on_map_changes(changes)
+//   p.set_pose(pose);  p.set_regions(regions);  p.on_controller_status(state, plan_id);
+//   auto out = p.tick(utime);                   // on every clock tick
+//   if (out.path) publish PLAN_PATH; if (out.roadmap) ROADMAP; if (out.status) PLANNER_STATUS
+//
+// A cycle runs at most every 1/rate_hz of message time, and not before the previous cycle's
+// charged time has passed. It replans (needs a new goal) when there is no goal, the goal was
+// reached (within goal_tolerance and yaw_tolerance, or the controller HOLDs the path's end near
+// it, for dwell_s; what the gain still counts in the camera's window there is then marked
+// unobservable and no gain counts it again), the rest of the path is no longer collision-free, or the
+// controller reported BRAKING, STALE_INPUT or REJECTED for the current plan (REJECTED also blacklists the
+// goal for blacklist_cycles; a reached goal is skipped for visited_cycles). DEP updates its roadmap every
+// cycle and, while flying, switches to a new goal when its score exceeds hysteresis × the current goal's
+// score now, or when the current goal's gain fell below min_gain; NBV and AEP plan only when a new goal is
+// needed (receding horizon). A cycle that needs a goal and finds none is RECOVERING (the next cycles sample
+// around frontier clusters only, with twice the attempts); after done_cycles such cycles in a row
+// the planner is DONE, for good, with the strategy's reason. When the path ahead became blocked
+// and no other goal is found, a one-waypoint path at the vehicle (hold there) is sent.
+//
+// Outputs of a cycle run at message time t (path, roadmap, status) are released by the first
+// tick at or after t + charged_s (charge_model.hpp); a path whose first waypoint the vehicle has
+// left by more than loop.max_start_offset by then is dropped and replanned at once.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <unordered_set>
+#include <vector>
+
+#include "semx/mapper/map_delta.hpp"
+#include "semx/mapper/state_grid.hpp"
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/frontier_tracker.hpp"
+#include "semx/planner/gain_evaluator.hpp"
+#include "semx/planner/plan_types.hpp"
+#include "semx/planner/planner_config.hpp"
+#include "semx/planner/rng.hpp"
+#include "semx/planner/semantic_reward.hpp"
+#include "semx/planner/strategy.hpp"
+
+namespace semx::planner {
+
+class ExplorationPlanner {
+ public:
+  explicit ExplorationPlanner(const PlannerConfig& config);
+
+  const PlannerConfig& config() const { return config_; }
+  PlannerKind kind() const { return kind_; }
+
+  // The map to plan on; must stay valid until replaced. A different grid counts as a reset.
+  void set_map(const mapper::StateGrid* grid);
+  // After the grid applied a delta (`changes` are its voxels and new states).
+  void on_map_changes(const std::vector<mapper::VoxelChange>& changes);
+  // After the grid's content was replaced (a snapshot).
+  void on_map_reset();
+  void set_pose(const VehiclePose& pose);
+  void set_regions(std::vector<SemanticRegion> regions) { regions_ = std::move(regions); }
+  void on_controller_status(ControllerState state, int64_t plan_id);
+
+  struct Output {
+    std::optional<PlannedPath> path;
+    std::optional<StatusReport> status;
+    std::optional<RoadmapView> roadmap;
+  };
+  Output tick(int64_t utime);
+  // A new episode: forget the roadmap, goal and state (the map is the caller's).
+  void reset();
+
+  PlannerState state() const { return state_; }
+  int64_t iteration() const { return iteration_; }
+  int64_t plan_id() const { return plan_id_; }
+  const Goal& goal() const { return goal_; }
+  bool busy() const { return pending_.active; }
+  const StatusReport& last_status() const { return last_status_; }
+  const FrontierTracker& frontiers() const { return frontiers_; }
+  const std::unordered_set<mapper::VoxelKey>& unobservable() const { return unobservable_; }
+  Strategy& strategy() { return *strategy_; }
+  const std::vector<SemanticRegion>& regions() const { return regions_; }
+
+ private:
+  struct Pending {
+    bool active = false;
+    int64_t ready_utime = 0;
+    bool has_path = false;
+    Goal goal;
+    std::optional<StatusReport> status;
+    std::optional<RoadmapView> roadmap;
+  };
+  void run_cycle(int64_t utime);
+  void release(Output& out, int64_t utime);
+  bool goal_reached(int64_t utime);
+  // After a goal was reached: what the gain still counts in the camera's window from the pose is
+  // unobservable from here (inside solids, in the camera's blind spots); gains stop counting it.
+  void mark_unobservable(CycleCounters& c);
+  bool path_blocked() const;
+  StatusReport make_status(PlannerState state, const std::string& reason, const CycleCounters& c,
+                           double charged, const Goal& best, const RoadmapView* view) const;
+
+  PlannerConfig config_;
+  PlannerKind kind_;
+  std::unique_ptr<Strategy> strategy_;
+  CollisionChecker checker_;
+  FrontierTracker frontiers_;
+  GainEvaluator gains_;
+  std::unordered_set<mapper::VoxelKey> unobservable_;
+  int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
+  Rng rng_;
+  const mapper::StateGrid* grid_ = nullptr;
+  std::optional<VehiclePose> pose_;
+  std::vector<SemanticRegion> regions_;
+
+  PlannerState state_ = PlannerState::kInit;
+  std::string reason_;
+  int64_t iteration_ = 0;
+  int64_t plan_id_ = 0;
+  int64_t next_cycle_utime_ = -1;
+  int no_goal_cycles_ = 0;
+  Goal goal_;  // being flown (valid after its path was released)
+  bool controller_trigger_ = false;
+  bool controller_rejected_ = false;
+  bool controller_holding_ = false;
+  std::string controller_reason_;
+  bool init_reported_ = false;
+  Pending pending_;
+  StatusReport last_status_;
+};
+
+}  // namespace semx::planner

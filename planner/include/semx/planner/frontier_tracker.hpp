@@ -1,0 +1,55 @@
+// The frontier voxels of the map (unknown with a free face neighbour), kept up to date from the
+// map's changes, and grouped in cubic cells ("clusters") that the sampler draws candidates around
+// and the main loop uses to tell whether any frontier is left.
+//
+// update() re-examines each changed voxel and its six neighbours (the only voxels whose frontier
+// status a change can flip), so its cost is proportional to the change, not to the map. reset()
+// scans the whole map (after a snapshot replaced it).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <unordered_set>
+#include <vector>
+
+#include "semx/mapper/map_delta.hpp"
+#include "semx/mapper/state_grid.hpp"
+
+namespace semx::planner {
+
+class FrontierTracker {
+ public:
+  explicit FrontierTracker(double cluster_size = 1.0);
+
+  void reset(const mapper::StateGrid& grid);
+  void update(const mapper::StateGrid& grid, const std::vector<mapper::VoxelChange>& changes);
+  void clear();
+
+  size_t size() const { return frontier_.size(); }
+  bool contains(const mapper::VoxelKey& k) const { return frontier_.count(k) != 0; }
+
+  struct Cluster {
+    mapper::VoxelKey cell;   // cell coordinates (floor(voxel centre / cluster_size))
+    Eigen::Vector3d centre;  // mean of its frontier voxels' centres, m
+    int64_t voxels = 0;
+  };
+  // Cells with at least min_voxels frontier voxels, in ascending cell order.
+  std::vector<Cluster> clusters(int64_t min_voxels) const;
+
+ private:
+  struct Cell {
+    int64_t voxels = 0;
+    int64_t sx = 0, sy = 0, sz = 0;  // sums of voxel keys
+  };
+  mapper::VoxelKey cell_of(const mapper::VoxelKey& k) const;
+  void set(const mapper::VoxelKey& k, bool frontier);
+  void recheck(mapper::StateGrid::Reader& r, const mapper::VoxelKey& k);
+
+  double cluster_size_;
+  double resolution_ = 0.0;
+  std::unordered_set<mapper::VoxelKey> frontier_;
+  std::map<mapper::VoxelKey, Cell> cells_;
+};
+
+}  // namespace semx::planner

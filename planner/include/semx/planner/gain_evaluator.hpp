@@ -1,0 +1,110 @@
+// The geometric gain G(n) = w_n U_n + w_f U_f + w_s U_s of a viewpoint (paper Eq. 1, DEP's
+// definition), per yaw bin, so each node gets the yaw whose camera window sees the most.
+//
+// Voxel kinds (disjoint; semx/mapper/state_grid.hpp, 6-connectivity):
+//   surface  (U_s): unknown, a free face neighbour and an occupied face neighbour;
+//   frontier (U_f): unknown, a free face neighbour, no occupied one;
+//   unknown  (U_n): any other unknown voxel ("normal").
+// Sensor model: a voxel counts when its centre c is within [min_range, max_range] of the node,
+// within the vertical field of view that every image column has (|tan elevation| ≤
+// tan(vfov/2)·cos(hfov/2), 28° for the default camera level with the body: conservative, so
+// that flying to a node and looking along its yaw sees what it counted) and it is reached by
+// a gain ray from the node before any occupied voxel (unknown space does not occlude: the
+// optimistic assumption of DEP and NBVP). It goes to the yaw bin of its azimuth. A yaw window
+// is `W = round(hfov / bin width)` consecutive bins (8 of 32 for the 90° camera); the node's gain
+// is that of its best window and its yaw is the window's centre.
+//
+// Rays: rays_azimuth × rays_elevation directions, evenly spread around the node and across the
+// vertical field of view, each walked voxel by voxel (3-D DDA) to max_range; each voxel counts at
+// most once per node. Rays sample the view: with the defaults (128 × 10) every voxel within about
+// 2 m is reached, farther ones in part, so U counts the distinct voxels the rays reach.
+// evaluate_exact() counts every visible voxel of the sector by enumeration (the reference of the
+// tests; far too slow for planning). Voxels in the ignored set (what a visited goal still counted
+// after the vehicle looked from it: unobservable, exploration_planner.hpp) count for nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <unordered_set>
+#include <vector>
+
+#include "semx/mapper/state_grid.hpp"
+#include "semx/planner/planner_config.hpp"
+
+namespace semx::planner {
+
+enum class GainVoxel : uint8_t { kUnknown = 0, kFrontier = 1, kSurface = 2 };
+
+// What one gain evaluation found.
+struct NodeGain {
+  std::vector<float> bin_gain;                    // weighted voxels per yaw bin
+  std::vector<std::array<int32_t, 3>> bin_count;  // voxels per bin and kind (GainVoxel order)
+  int best_window = 0;                            // first bin of the best window
+  double gain = 0.0;                              // G at the best window
+  double yaw = 0.0;                               // centre of the best window, rad
+  std::array<int64_t, 3> counts{};                // U_n, U_f, U_s in the best window
+  bool valid = false;
+
+  int64_t total_voxels() const;  // over all bins
+};
+
+struct GainStats {
+  int64_t evaluations = 0;
+  int64_t rays = 0;
+  int64_t steps = 0;  // voxels visited by rays
+};
+
+class GainEvaluator {
+ public:
+  explicit GainEvaluator(const GainConfig& config);
+
+  const GainConfig& config() const { return config_; }
+  int bins() const { return config_.yaw_bins; }
+  int window_bins() const { return window_; }
+  double bin_width() const;
+  // Yaw at the centre of the window that starts at bin j.
+  double window_yaw(int j) const;
+  // Bin of an azimuth (rad).
+  int bin_of(double azimuth) const;
+  // The voxel's kind, or false when it is not unknown.
+  static bool classify(mapper::StateGrid::Reader& r, const mapper::VoxelKey& k, GainVoxel& kind);
+
+  // Ray-cast gain (the planner's). Not thread-safe (reuses a scratch bitset).
+  NodeGain evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats = nullptr);
+  // As evaluate(), also listing the voxels counted in the window centred nearest to `yaw`.
+  NodeGain evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
+                    std::vector<mapper::VoxelKey>* counted, GainStats* stats = nullptr);
+  // Voxels never to count (unobservable_set.hpp); null for none. Must outlive the evaluator's use.
+  void set_ignored(const std::unordered_set<mapper::VoxelKey>* ignored) { ignored_ = ignored; }
+  // Every voxel of the sector, each tested with its own line of sight (reference for tests).
+  NodeGain evaluate_exact(const mapper::StateGrid& grid, const Eigen::Vector3d& p) const;
+
+  // First bin of the window centred nearest to `yaw`.
+  int window_of(double yaw) const;
+  // Fills best_window, gain, yaw and counts from the bins.
+  void finish(NodeGain& g) const;
+  // Gain of the window centred nearest to `yaw`.
+  double gain_at_yaw(const NodeGain& g, double yaw) const;
+
+ private:
+  bool in_sector(const Eigen::Vector3d& offset) const;
+  // Bin of an offset's azimuth, starting the search from a guess (the ray's bin): exact, without
+  // atan2 (cross products with the bins' boundary directions).
+  int bin_near(const Eigen::Vector3d& offset, int guess) const;
+  void add(NodeGain& g, int bin, GainVoxel kind) const;
+
+  GainConfig config_;
+  int window_ = 1;
+  double tan_half_vfov_ = 0.0;
+  std::vector<Eigen::Vector3d> directions_;
+  std::vector<int> direction_bin_;             // bin of each direction's azimuth
+  std::vector<Eigen::Vector2d> bin_boundary_;  // unit vector at the start of each bin
+  // Scratch: one bit per voxel of the box around the node, "already counted".
+  std::vector<uint64_t> seen_;
+  const std::unordered_set<mapper::VoxelKey>* ignored_ = nullptr;
+  double seen_res_ = 0.0;
+  int hx_ = 0, hz_ = 0;
+};
+
+}  // namespace semx::planner

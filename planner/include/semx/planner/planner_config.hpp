@@ -1,0 +1,157 @@
+// Every parameter of the planner, with its default. This struct is the one place defaults are set;
+// docs/planner.md and planner/config/planner.yaml mirror it (a test loads the YAML file and
+// compares it with these defaults).
+//
+// YAML layout: top-level `planner`, `seed`, `rate_hz`, then one mapping per struct below, keys
+// named as the fields (vectors as YAML sequences).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+
+#include "semx/runtime/config.hpp"
+
+namespace semx::planner {
+
+// The four planners of the paper's comparison (DESIGN.md §4).
+enum class PlannerKind {
+  kSemanticDep,  // DEP roadmap + semantic reward (the paper's method)
+  kDep,          // the same roadmap, semantics off
+  kNbv,          // receding-horizon RRT next-best-view (Bircher 2016)
+  kAep,          // RRT* with cached gains and frontier fallback (Selin 2019)
+};
+const char* to_string(PlannerKind k);
+// Throws std::invalid_argument for an unknown name.
+PlannerKind parse_planner_kind(const std::string& name);
+
+// The vehicle and how far paths keep from what is not known to be free (CollisionChecker).
+struct CollisionConfig {
+  Eigen::Vector3d vehicle_size{0.5, 0.5, 0.3};  // m, body box (x, y, z)
+  double margin = 0.1;                          // m, added to each half size of the body box
+  // m: Euclidean distance every node keeps from occupied and unknown voxels (to their cubes). The
+  // controller rejects waypoints closer than 0.4 m (ESDF, unknown counts as occupied), so 0.45.
+  double clearance = 0.45;
+  // m: edges are checked at points at most this far apart; every point between keeps
+  // clearance - edge_step / 2 (0.40 m).
+  double edge_step = 0.1;
+  // m: near the vehicle an edge from the root is checked only against occupied voxels and the
+  // bare vehicle box, so the vehicle can leave a pose whose surroundings are not mapped yet.
+  double root_escape_radius = 1.0;
+};
+
+// Where candidate nodes are drawn.
+struct SamplingConfig {
+  int samples = 45;                // candidates kept per cycle at most: the paper's sampling density
+  int max_attempts_factor = 4;     // candidates collision-checked per cycle at most samples × this
+  int max_draws_factor = 25;       // draws at most samples × max_attempts_factor × this (a draw whose
+                                   // voxel is not free is dropped before any check)
+  double local_radius = 5.0;       // m, horizontal half width of the box around the vehicle
+  double local_height = 1.0;       // m, vertical half height of that box
+  double frontier_fraction = 0.4;  // share of draws around frontier clusters (anywhere)
+  double frontier_radius = 1.5;    // m, half width of the box drawn around a frontier cluster
+  double min_node_distance = 0.5;  // m, a candidate closer than this to a node is dropped
+  double z_min = 0.3;              // m, absolute limits of node heights
+  double z_max = 3.0;
+  double cluster_size = 1.0;   // m, edge of the cells frontier voxels are grouped in
+  int min_cluster_voxels = 3;  // frontier voxels a cell needs to attract samples
+};
+
+struct RoadmapConfig {
+  int k_nearest = 8;             // a new node is connected to at most this many nearest nodes
+  double max_edge_length = 2.5;  // m
+};
+
+// The sensor model of the gain and the gain's weights.
+struct GainConfig {
+  // Camera (DESIGN.md §5: 90° horizontal, fx = fy = 320 at 640 × 480): the frustum's horizontal
+  // and vertical field of view come from these.
+  int image_width = 640;
+  int image_height = 480;
+  double fx = 320.0;
+  double fy = 320.0;
+  double min_range = 0.5;  // m
+  double max_range = 5.0;  // m
+  // G = w_unknown U_n + w_frontier U_f + w_surface U_s (DEP's 1, 2, 4).
+  double weight_unknown = 1.0;
+  double weight_frontier = 2.0;
+  double weight_surface = 4.0;
+  int yaw_bins = 32;        // azimuth histogram (DEP)
+  int rays_azimuth = 128;   // gain rays around the node (a multiple of yaw_bins)
+  int rays_elevation = 10;  // rays across the vertical field of view
+  double min_gain = 20.0;   // a node with G below this is not a goal (weighted voxels)
+
+  double horizontal_fov() const;  // rad
+  double vertical_fov() const;    // rad
+};
+
+struct CostConfig {
+  double velocity = 1.0;    // m/s, v of T = d/v + w_psi Δψ/ω
+  double yaw_rate = 1.0;    // rad/s, ω
+  double yaw_weight = 1.0;  // w_psi
+  double min_time = 0.5;    // s, T is at least this, so a node next to the vehicle scores finitely
+};
+
+// The main loop: when to replan, when to give up.
+struct LoopConfig {
+  double goal_tolerance = 0.3;  // m, the goal counts as reached within this
+  double yaw_tolerance = 0.3;   // rad, a turn smaller than this is no reason to move
+  double dwell_s = 0.3;         // s within tolerance before the goal counts as reached
+  double hysteresis = 1.5;      // switch goals only for a score this many times better
+  int done_cycles = 5;          // consecutive cycles without any goal before DONE
+  int blacklist_cycles = 20;    // a goal the controller rejected is skipped this long
+  // A goal just reached is skipped this long: what its gain still counts after the vehicle stood
+  // there and looked is what the camera could not see (sensor-model mismatch), not a reason to
+  // come back at once.
+  int visited_cycles = 40;
+  double max_start_offset = 0.6;  // m, a pending path whose start the vehicle left is dropped
+};
+
+// The deterministic charge for planning time (docs/planner.md, "Planning time").
+struct ChargeConfig {
+  double base_s = 5.0e-4;             // per cycle
+  double per_box_check_s = 2.0e-6;    // per vehicle-box collision check (nodes and edge samples)
+  double per_gain_node_s = 1.0e-5;    // per gain evaluation
+  double per_ray_step_s = 1.2e-8;     // per voxel stepped by a gain ray
+  double per_search_node_s = 2.0e-7;  // per node settled by the graph search
+  double scale = 1.0;                 // multiplies everything (0: planning is free)
+};
+
+// Receding-horizon NBV (Bircher 2016).
+struct NbvConfig {
+  double step = 1.0;    // m, RRT extension step (the first edge is what is flown)
+  double lambda = 0.5;  // 1/m, branch value Σ gain·exp(-λ·cost)
+  double radius = 5.0;  // m, half width of the sampling box around the vehicle
+};
+
+// AEP (Selin 2019).
+struct AepConfig {
+  double step = 1.0;           // m, RRT* extension step
+  double rewire_radius = 1.5;  // m
+  double lambda = 0.5;         // 1/m
+  double radius = 5.0;         // m, local sampling box half width
+  double cache_radius = 0.3;   // m, a cached gain this close to a tree node is reused
+  double g_zero = 40.0;        // local gain below this triggers the frontier fallback
+};
+
+struct PlannerConfig {
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep
+  int64_t seed = 1;
+  double rate_hz = 4.0;  // planning cycles per simulated second, at most
+  CollisionConfig collision;
+  SamplingConfig sampling;
+  RoadmapConfig roadmap;
+  GainConfig gain;
+  CostConfig cost;
+  LoopConfig loop;
+  ChargeConfig charge;
+  NbvConfig nbv;
+  AepConfig aep;
+
+  PlannerKind kind() const { return parse_planner_kind(planner); }
+};
+
+// Strict loader (unknown keys and out-of-range values are errors naming the key).
+void load(runtime::ConfigMap& m, PlannerConfig& c);
+
+}  // namespace semx::planner

@@ -1,0 +1,84 @@
+// What the main loop (ExplorationPlanner) asks of a planning method: one cycle's best goal and
+// the path to it. DEP (with or without semantics), NBV and AEP implement it (dep_strategy.hpp,
+// nbv_strategy.hpp, aep_strategy.hpp) on the same map, sensor model and collision checks.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "semx/mapper/map_delta.hpp"
+#include "semx/mapper/state_grid.hpp"
+#include "semx/planner/frontier_tracker.hpp"
+#include "semx/planner/plan_types.hpp"
+#include "semx/planner/planner_config.hpp"
+#include "semx/planner/rng.hpp"
+#include "semx/planner/semantic_reward.hpp"
+
+namespace semx::planner {
+
+struct PlanContext {
+  const mapper::StateGrid* grid = nullptr;
+  VehiclePose pose;
+  const std::vector<SemanticRegion>* regions = nullptr;  // empty when semantics are off
+  const FrontierTracker* frontiers = nullptr;
+  // Voxels that gains ignore (seen as unobservable after a visit; exploration_planner.hpp).
+  const std::unordered_set<mapper::VoxelKey>* unobservable = nullptr;
+  int64_t cycle = 0;
+  bool recovering = false;  // the previous cycles found no goal: sample for frontiers
+  Rng* rng = nullptr;
+  CycleCounters* counters = nullptr;
+};
+
+// A goal and the path to it.
+struct Goal {
+  bool valid = false;
+  int64_t node = -1;  // roadmap node id (DEP, AEP fallback), -1 otherwise
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double yaw = 0.0;
+  double gain = 0.0, reward = 0.0, cost = 0.0, score = 0.0;
+  std::vector<Eigen::Vector3d> waypoints;  // first = the vehicle's position
+  std::vector<double> yaws;
+};
+
+struct PlanOutcome {
+  Goal goal;           // invalid when nothing worth flying to was found
+  std::string reason;  // why there is no goal (becomes the DONE reason)
+};
+
+class Strategy {
+ public:
+  virtual ~Strategy() = default;
+
+  // The map changed (the grid already holds the new states) / was replaced wholesale.
+  virtual void on_map_changes(const std::vector<mapper::VoxelChange>& changes) = 0;
+  virtual void on_map_reset() = 0;
+  // The gain model changed for these voxels (they became unobservable): cached gains in sensor
+  // range of them are stale.
+  virtual void on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) = 0;
+  // One planning cycle.
+  virtual PlanOutcome plan(PlanContext& ctx) = 0;
+  // The score the goal being flown has now (same cycle's roadmap), or nullopt when it is gone or
+  // no longer worth it. Receding-horizon methods return nullopt without work (never called).
+  virtual std::optional<double> goal_score(PlanContext& ctx, const Goal& goal) = 0;
+  // The controller could not fly to this goal: avoid it for a while.
+  virtual void reject_goal(const Goal& goal, int64_t until_cycle) = 0;
+  // NBV and AEP fly the first edge of their best branch and replan on arrival; DEP keeps its
+  // goal and switches only for a much better one.
+  virtual bool receding_horizon() const = 0;
+  virtual RoadmapView roadmap(const Goal* goal) const = 0;
+  virtual void reset() = 0;
+};
+
+// The strategy for `config.kind()`.
+std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config);
+
+// Yaws for a polyline: from `start_yaw` to `goal_yaw` (the shorter way), linear in arc length.
+std::vector<double> interpolate_yaws(const std::vector<Eigen::Vector3d>& waypoints, double start_yaw,
+                                     double goal_yaw);
+
+}  // namespace semx::planner

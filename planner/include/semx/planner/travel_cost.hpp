@@ -1,0 +1,26 @@
+// Travel cost and score of a candidate (paper Eq. 8-9):
+//   T_path = d / v + w_psi · Δψ / ω,   Score = (G + R_sem) / T_path,
+// d the length of the roadmap path from the vehicle to the node, Δψ the turn from the vehicle's
+// heading to the node's best yaw (the smaller way round, in [0, π]). T_path is floored at
+// CostConfig::min_time so that the node under the vehicle cannot score infinitely.
+#pragma once
+
+#include <algorithm>
+
+#include "semx/planner/angles.hpp"
+#include "semx/planner/planner_config.hpp"
+
+namespace semx::planner {
+
+inline double travel_time(double distance, double yaw_change, const CostConfig& c) {
+  const double t = distance / c.velocity + c.yaw_weight * std::abs(yaw_change) / c.yaw_rate;
+  return std::max(t, c.min_time);
+}
+
+inline double travel_time(double distance, double from_yaw, double to_yaw, const CostConfig& c) {
+  return travel_time(distance, yaw_distance(from_yaw, to_yaw), c);
+}
+
+inline double node_score(double gain, double reward, double time) { return (gain + reward) / time; }
+
+}  // namespace semx::planner

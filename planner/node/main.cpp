@@ -1,0 +1,38 @@
+// semx-planner: the exploration planner (DEP with semantic reward, or the DEP/NBV/AEP baselines)
+// as an LCM process (docs/planner.md).
+#include <iostream>
+
+#include "planner_node.hpp"
+#include "semx/runtime/config.hpp"
+#include "semx/runtime/node_flags.hpp"
+
+using namespace semx::runtime;
+
+int main(int argc, char** argv) {
+  return run_main("semx-planner", [&] {
+    NodeFlags flags("planner");
+    std::string config_file, planner;
+    std::vector<std::string> overrides;
+    int64_t seed = -1, samples = 0;
+    ArgParser p(
+        "semx-planner",
+        "Plans exploration goals on the mapper's map: publishes PLAN_PATH, ROADMAP and PLANNER_STATUS.");
+    flags.add_to(p);
+    p.option("config", "FILE", "planner YAML (default: built-in defaults, docs/planner.md)", &config_file)
+        .repeated("set", "KEY=VALUE", "override one config key, e.g. --set gain.min_gain=30", &overrides)
+        .option("planner", "NAME", "semantic-dep (default), dep, nbv or aep (= --set planner=NAME)", &planner)
+        .option("seed", "N", "random seed (= --set seed=N)", &seed)
+        .option("samples", "N", "sampling density (= --set sampling.samples=N)", &samples);
+    if (!p.parse(argc, argv)) return 0;
+    if (!planner.empty()) overrides.push_back("planner=" + planner);
+    if (seed >= 0) overrides.push_back("seed=" + std::to_string(seed));
+    if (samples != 0) overrides.push_back("sampling.samples=" + std::to_string(samples));
+    const auto config = load_config<semx::planner::PlannerConfig>(config_file, overrides);
+
+    semx::planner::PlannerNode node(flags.options(), config);
+    install_shutdown_handlers();
+    std::cout << "semx-planner: " << config.planner << ", " << config.sampling.samples << " samples, seed "
+              << config.seed << " on " << node.node().url() << "\n";
+    return node.run();
+  });
+}

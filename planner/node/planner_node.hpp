@@ -1,0 +1,48 @@
+// The planner process around the logic (docs/planner.md, "The node"): the map client keeps a copy
+// of the mapper's map, the subscriptions feed the ExplorationPlanner, and each SIM_CLOCK tick runs
+// its main loop and publishes what it released.
+//
+//   subscribes  MAP_UPDATE, MAP_SNAPSHOT (MapClient; sends MAP_REQUEST), ODOMETRY,
+//               SEMANTIC_REGIONS, CONTROLLER_STATUS, SIM_CLOCK
+//   publishes   PLAN_PATH (per new goal), ROADMAP (per cycle), PLANNER_STATUS (per cycle, on
+//               change, and again every status_period_s of message time)
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "map_client.hpp"
+#include "semx/planner/exploration_planner.hpp"
+#include "semx/planner/planner_config.hpp"
+#include "semx/runtime/node.hpp"
+
+namespace semx::planner {
+
+class PlannerNode {
+ public:
+  PlannerNode(runtime::NodeOptions options, const PlannerConfig& config);
+
+  runtime::Node& node() { return node_; }
+  ExplorationPlanner& planner() { return planner_; }
+  const mapper::MapClient& map() const { return *map_; }
+  int run() { return node_.run(); }
+
+  // One tick of simulation time (what SIM_CLOCK triggers); public for tests.
+  void on_tick(int64_t tick, int64_t utime);
+
+  // PLANNER_STATUS is repeated this often (message time) so late listeners learn the state.
+  static constexpr double kStatusPeriodS = 1.0;
+
+ private:
+  void update_node_state();
+
+  PlannerConfig config_;
+  runtime::Node node_;
+  std::unique_ptr<mapper::MapClient> map_;
+  ExplorationPlanner planner_;
+  int64_t last_utime_ = -1;
+  int64_t last_status_utime_ = -1;
+  PlannerState reported_state_ = PlannerState::kInit;
+};
+
+}  // namespace semx::planner

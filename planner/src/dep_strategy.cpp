@@ -1,0 +1,405 @@
+#include "semx/planner/dep_strategy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <sstream>
+#include <utility>
+
+#include "semx/planner/angles.hpp"
+#include "semx/planner/travel_cost.hpp"
+#include "stopwatch.hpp"
+
+namespace semx::planner {
+
+using mapper::VoxelKey;
+using mapper::VoxelState;
+
+DepStrategy::DepStrategy(const PlannerConfig& config, bool semantic)
+    : config_(config),
+      semantic_(semantic),
+      checker_(config.collision),
+      gains_(config.gain),
+      sampler_(config.sampling),
+      graph_(config.roadmap.max_edge_length) {}
+
+void DepStrategy::reset() {
+  graph_.clear();
+  root_ = -1;
+  changed_blocks_.clear();
+  obstacle_voxels_.clear();
+  full_reset_ = false;
+  search_ = Roadmap::Search();
+  reward_.clear();
+  cost_.clear();
+  score_.clear();
+}
+
+void DepStrategy::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+  for (const mapper::VoxelChange& c : changes) {
+    const VoxelKey b = mapper::block_of(c.key);
+    changed_blocks_.insert(b);
+    if (c.state != VoxelState::kFree) obstacle_voxels_[b].push_back(c.key);
+  }
+}
+
+void DepStrategy::on_map_reset() { full_reset_ = true; }
+
+void DepStrategy::on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) {
+  for (const VoxelKey& k : keys) changed_blocks_.insert(mapper::block_of(k));
+}
+
+bool DepStrategy::obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                                double res) const {
+  const double block = mapper::kBlockSize * res;
+  const Eigen::Vector3d lo = a.cwiseMin(b).array() - radius, hi = a.cwiseMax(b).array() + radius;
+  const Eigen::Vector3d d = b - a;
+  const double dd = d.squaredNorm();
+  const double r2 = radius * radius;
+  for (const auto& [blk, voxels] : obstacle_voxels_) {
+    const Eigen::Vector3d b0(blk.x * block, blk.y * block, blk.z * block);
+    const Eigen::Vector3d b1 = b0 + Eigen::Vector3d::Constant(block);
+    if ((b1.array() < lo.array()).any() || (b0.array() > hi.array()).any()) continue;
+    for (const VoxelKey& k : voxels) {
+      const Eigen::Vector3d c((k.x + 0.5) * res, (k.y + 0.5) * res, (k.z + 0.5) * res);
+      const double t = dd > 0 ? std::clamp((c - a).dot(d) / dd, 0.0, 1.0) : 0.0;
+      if ((a + t * d - c).squaredNorm() < r2) return true;
+    }
+  }
+  return false;
+}
+
+void DepStrategy::process_map_changes(PlanContext& ctx) {
+  const mapper::StateGrid& grid = *ctx.grid;
+  checker_.set_grid(&grid);
+  gains_.set_ignored(ctx.unobservable);
+  const double res = grid.resolution();
+  const double block = mapper::kBlockSize * res;
+  const double half_diag = 0.5 * block * std::sqrt(3.0);
+  auto centre = [&](const VoxelKey& b) {
+    return Eigen::Vector3d((b.x + 0.5) * block, (b.y + 0.5) * block, (b.z + 0.5) * block);
+  };
+  // A voxel whose centre is farther than this from every point checked cannot change a check.
+  const double reach = checker_.half_extent().norm() + 0.5 * res * std::sqrt(3.0) + 1e-6;
+  std::vector<int64_t> recheck;
+  if (full_reset_) {
+    for (const RoadmapNode& n : graph_.slots()) {
+      if (!n.alive) continue;
+      graph_.node(n.id).gain_stale = true;
+      recheck.push_back(n.id);
+    }
+  } else {
+    const double stale_radius = config_.gain.max_range + half_diag + res;
+    for (const VoxelKey& b : changed_blocks_) {
+      for (int64_t id : graph_.nearest(centre(b), -1, stale_radius)) graph_.node(id).gain_stale = true;
+    }
+    const double prune_radius = 0.5 * config_.roadmap.max_edge_length + reach + half_diag;
+    std::set<int64_t> near;
+    for (const auto& entry : obstacle_voxels_) {
+      for (int64_t id : graph_.nearest(centre(entry.first), -1, prune_radius)) near.insert(id);
+    }
+    recheck.assign(near.begin(), near.end());
+  }
+  const bool everything = full_reset_;
+  changed_blocks_.clear();
+  full_reset_ = false;
+
+  for (int64_t id : recheck) {
+    if (!graph_.alive(id)) continue;
+    const Eigen::Vector3d a = graph_.node(id).position;
+    if (id != root_ && (everything || obstacle_near(a, a, reach, res)) && !checker_.node_free(a)) {
+      graph_.remove_node(id);
+      ++ctx.counters->nodes_pruned;
+      continue;
+    }
+    // Each edge once (skipped from the higher end when the lower end is rechecked too).
+    const std::vector<RoadmapEdge> edges = graph_.node(id).edges;
+    for (const RoadmapEdge& e : edges) {
+      if (e.to < id && std::binary_search(recheck.begin(), recheck.end(), e.to)) continue;
+      const Eigen::Vector3d& b = graph_.node(e.to).position;
+      if (!everything && !obstacle_near(a, b, reach, res)) continue;
+      ++ctx.counters->edges_checked;
+      const bool ok = (id == root_ || e.to == root_)
+                          ? checker_.root_edge_free(id == root_ ? a : b, id == root_ ? b : a)
+                          : checker_.edge_free(a, b);
+      if (!ok) {
+        graph_.remove_edge(id, e.to);
+        ++ctx.counters->edges_pruned;
+      }
+    }
+  }
+  obstacle_voxels_.clear();
+}
+
+int64_t DepStrategy::insert_root(PlanContext& ctx) {
+  const double min_d = config_.sampling.min_node_distance;
+  const Eigen::Vector3d p = ctx.pose.position;
+  if (graph_.alive(root_) && (graph_.node(root_).position - p).norm() < 0.5 * min_d) {
+    // The vehicle has hardly moved (hovering, turning): the same root, moved to the pose, so a
+    // goal that is the root (a turn in place) keeps its id.
+    graph_.move_node(root_, p);
+    const std::vector<RoadmapEdge> edges = graph_.node(root_).edges;
+    for (const RoadmapEdge& e : edges) graph_.remove_edge(root_, e.to);
+  } else {
+    if (graph_.alive(root_)) {
+      RoadmapNode& old = graph_.node(root_);
+      const bool keep = checker_.node_free(old.position) && !graph_.any_within(old.position, min_d, root_);
+      if (!keep) {
+        graph_.remove_node(root_);
+      } else {
+        // Its edges were checked with the root's escape rule: hold them to the full one now.
+        const std::vector<RoadmapEdge> edges = old.edges;
+        for (const RoadmapEdge& e : edges) {
+          ++ctx.counters->edges_checked;
+          if (!checker_.edge_free(graph_.node(root_).position, graph_.node(e.to).position)) {
+            graph_.remove_edge(root_, e.to);
+          }
+        }
+        if (graph_.node(root_).edges.empty()) graph_.remove_node(root_);
+      }
+    }
+    root_ = graph_.add_node(p);
+  }
+  // The root's gain is evaluated afresh every cycle (the vehicle moved or the view changed).
+  graph_.node(root_).gain = NodeGain();
+  graph_.node(root_).gain_stale = true;
+  for (int64_t id : graph_.nearest(p, config_.roadmap.k_nearest, config_.roadmap.max_edge_length, root_)) {
+    ++ctx.counters->edges_checked;
+    if (checker_.root_edge_free(p, graph_.node(id).position)) {
+      graph_.add_edge(root_, id, (graph_.node(id).position - p).norm());
+      ++ctx.counters->edges_added;
+    }
+  }
+  return root_;
+}
+
+int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& p) {
+  Stopwatch sample_watch;
+  const bool ok = checker_.node_free(p) && !graph_.any_within(p, config_.sampling.min_node_distance);
+  ctx.counters->sample_ms += sample_watch.ms();
+  if (!ok) return -1;
+  Stopwatch connect_watch;
+  std::vector<std::pair<int64_t, double>> links;
+  for (int64_t id : graph_.nearest(p, config_.roadmap.k_nearest, config_.roadmap.max_edge_length)) {
+    const Eigen::Vector3d& q = graph_.node(id).position;
+    ++ctx.counters->edges_checked;
+    const bool free = id == root_ ? checker_.root_edge_free(q, p) : checker_.edge_free(p, q);
+    if (free) links.emplace_back(id, (q - p).norm());
+  }
+  int64_t id = -1;
+  if (!links.empty()) {
+    id = graph_.add_node(p);
+    for (const auto& [to, length] : links) {
+      graph_.add_edge(id, to, length);
+      ++ctx.counters->edges_added;
+    }
+    ++ctx.counters->nodes_added;
+  }
+  ctx.counters->connect_ms += connect_watch.ms();
+  return id;
+}
+
+void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
+  Stopwatch w;
+  GainStats stats;
+  RoadmapNode& n = graph_.node(id);
+  n.gain = gains_.evaluate(*ctx.grid, n.position, &stats);
+  n.gain_stale = false;
+  n.gain_cycle = ctx.cycle;
+  ctx.counters->gain_evaluations += stats.evaluations;
+  ctx.counters->rays += stats.rays;
+  ctx.counters->ray_steps += stats.steps;
+  ctx.counters->gain_ms += w.ms();
+}
+
+double DepStrategy::score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const {
+  const RoadmapNode& n = graph_.node(id);
+  const double reward = semantic_ && ctx.regions ? semantic_reward(n.position, *ctx.regions) : 0.0;
+  return score(n.gain.gain, reward, search_.distance[static_cast<size_t>(id)],
+               yaw_distance(ctx.pose.yaw, n.gain.yaw));
+}
+
+bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id) const {
+  const RoadmapNode& n = graph_.node(id);
+  return search_.distance[static_cast<size_t>(id)] < config_.loop.goal_tolerance &&
+         yaw_distance(ctx.pose.yaw, n.gain.yaw) < config_.loop.yaw_tolerance;
+}
+
+Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason) {
+  {
+    Stopwatch w;
+    search_ = graph_.shortest_paths(root_);
+    ctx.counters->search_settled += search_.settled;
+    ctx.counters->search_ms += w.ms();
+  }
+  const size_t slots = graph_.slots().size();
+  reward_.assign(slots, 0.0);
+  cost_.assign(slots, -1.0);
+  score_.assign(slots, 0.0);
+
+  using Item = std::pair<double, int64_t>;  // (score, -id): ties go to the lower id
+  std::priority_queue<Item> queue;
+  int64_t reachable = 0;
+  const double min_gain = config_.gain.min_gain;
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (!n.alive || !search_.reached(n.id)) continue;
+    ++reachable;
+    if (!n.gain.valid) evaluate_gain(ctx, n.id);
+    const RoadmapNode& m = graph_.node(n.id);
+    const double reward = semantic_ && ctx.regions ? semantic_reward(m.position, *ctx.regions) : 0.0;
+    reward_[static_cast<size_t>(n.id)] = reward;
+    cost_[static_cast<size_t>(n.id)] =
+        travel_time(search_.distance[static_cast<size_t>(n.id)], ctx.pose.yaw, m.gain.yaw, config_.cost);
+    score_[static_cast<size_t>(n.id)] = score_of(ctx, score, n.id);
+    if (m.blacklisted_until >= ctx.cycle) continue;
+    if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id)) continue;
+    queue.emplace(score_[static_cast<size_t>(n.id)], -n.id);
+  }
+  Goal goal;
+  while (!queue.empty()) {
+    const int64_t id = -queue.top().second;
+    queue.pop();
+    RoadmapNode& n = graph_.node(id);
+    if (n.gain_stale) {
+      evaluate_gain(ctx, id);
+      const double s = score_of(ctx, score, id);
+      score_[static_cast<size_t>(id)] = s;
+      cost_[static_cast<size_t>(id)] =
+          travel_time(search_.distance[static_cast<size_t>(id)], ctx.pose.yaw, n.gain.yaw, config_.cost);
+      if (n.gain.gain >= min_gain && !nothing_to_do(ctx, id)) queue.emplace(s, -id);
+      continue;
+    }
+    goal.valid = true;
+    goal.node = id;
+    goal.position = n.position;
+    goal.yaw = n.gain.yaw;
+    goal.gain = n.gain.gain;
+    goal.reward = reward_[static_cast<size_t>(id)];
+    goal.cost = cost_[static_cast<size_t>(id)];
+    goal.score = score_[static_cast<size_t>(id)];
+    for (int64_t p : Roadmap::path_to(search_, id)) goal.waypoints.push_back(graph_.node(p).position);
+    goal.yaws = interpolate_yaws(goal.waypoints, ctx.pose.yaw, goal.yaw);
+    break;
+  }
+  if (!goal.valid && reason) {
+    std::ostringstream s;
+    const size_t clusters =
+        ctx.frontiers ? ctx.frontiers->clusters(config_.sampling.min_cluster_voxels).size() : 0;
+    s << "no reachable node with gain >= " << min_gain << " (" << reachable << " of " << graph_.num_nodes()
+      << " nodes reachable); " << (ctx.frontiers ? ctx.frontiers->size() : 0) << " frontier voxels in "
+      << clusters << " clusters left, none reachable";
+    *reason = s.str();
+  }
+  return goal;
+}
+
+PlanOutcome DepStrategy::plan(PlanContext& ctx) {
+  checker_.set_grid(ctx.grid);
+  checker_.reset_counters();
+  process_map_changes(ctx);
+  insert_root(ctx);
+
+  // Sampling around the vehicle and the frontier clusters.
+  std::vector<FrontierTracker::Cluster> clusters;
+  if (ctx.frontiers) clusters = ctx.frontiers->clusters(config_.sampling.min_cluster_voxels);
+  const double fraction = ctx.recovering ? 1.0 : config_.sampling.frontier_fraction;
+  const int64_t checks = static_cast<int64_t>(config_.sampling.samples) *
+                         config_.sampling.max_attempts_factor * (ctx.recovering ? 2 : 1);
+  const int64_t draws = checks * config_.sampling.max_draws_factor;
+  int64_t checked = 0;
+  int kept = 0;
+  for (int64_t i = 0; i < draws && checked < checks && kept < config_.sampling.samples; ++i) {
+    ++ctx.counters->samples_drawn;
+    Stopwatch w;
+    const Eigen::Vector3d p = sampler_.draw(*ctx.rng, ctx.pose.position, clusters, fraction);
+    const bool free = ctx.grid->state(p) == VoxelState::kFree;
+    ctx.counters->sample_ms += w.ms();
+    if (!free) continue;
+    ++checked;
+    if (try_insert(ctx, p) >= 0) ++kept;
+  }
+
+  PlanOutcome out;
+  out.goal = select_goal(ctx, paper_score(), &out.reason);
+  ctx.counters->box_checks += checker_.box_checks();
+  checker_.reset_counters();
+  return out;
+}
+
+DepStrategy::ScoreFn DepStrategy::paper_score() const {
+  const CostConfig cost = config_.cost;
+  return [cost](double gain, double reward, double distance, double yaw_change) {
+    return node_score(gain, reward, travel_time(distance, yaw_change, cost));
+  };
+}
+
+std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal) {
+  if (!graph_.alive(goal.node) || search_.distance.size() <= static_cast<size_t>(goal.node) ||
+      !search_.reached(goal.node)) {
+    return std::nullopt;
+  }
+  RoadmapNode& n = graph_.node(goal.node);
+  if (n.gain_stale || !n.gain.valid) evaluate_gain(ctx, goal.node);
+  if (n.gain.gain < config_.gain.min_gain) return std::nullopt;
+  const double reward = semantic_ && ctx.regions ? semantic_reward(n.position, *ctx.regions) : 0.0;
+  // The goal keeps the yaw it was chosen with (its best yaw may have moved since).
+  const double g = gains_.gain_at_yaw(n.gain, goal.yaw);
+  return node_score(
+      g, reward,
+      travel_time(search_.distance[static_cast<size_t>(goal.node)], ctx.pose.yaw, goal.yaw, config_.cost));
+}
+
+void DepStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
+  if (graph_.alive(goal.node)) graph_.node(goal.node).blacklisted_until = until_cycle;
+}
+
+RoadmapView DepStrategy::roadmap(const Goal* goal) const {
+  RoadmapView v;
+  std::set<int64_t> on_path;
+  if (goal && goal->valid &&
+      search_.distance.size() > static_cast<size_t>(std::max<int64_t>(goal->node, 0))) {
+    for (int64_t id : Roadmap::path_to(search_, goal->node)) on_path.insert(id);
+  }
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (!n.alive) continue;
+    RoadmapView::Node out;
+    out.id = n.id;
+    out.position = n.position;
+    out.yaw = n.gain.yaw;
+    out.gain = n.gain.gain;
+    const size_t i = static_cast<size_t>(n.id);
+    if (i < reward_.size()) {
+      out.reward = reward_[i];
+      out.cost = cost_[i];
+      out.score = score_[i];
+    }
+    if (n.id == root_) out.flags |= kFlagRoot;
+    if (goal && goal->valid && n.id == goal->node) out.flags |= kFlagGoal;
+    if (on_path.count(n.id)) out.flags |= kFlagOnPath;
+    if (n.gain.valid && n.gain.counts[1] + n.gain.counts[2] > 0) out.flags |= kFlagFrontier;
+    v.nodes.push_back(out);
+    for (const RoadmapEdge& e : n.edges) {
+      if (e.to > n.id) v.edges.emplace_back(n.id, e.to);
+    }
+  }
+  return v;
+}
+
+std::vector<double> interpolate_yaws(const std::vector<Eigen::Vector3d>& w, double start_yaw,
+                                     double goal_yaw) {
+  std::vector<double> yaws(w.size(), goal_yaw);
+  if (w.size() < 2) return yaws;
+  double total = 0.0;
+  for (size_t i = 1; i < w.size(); ++i) total += (w[i] - w[i - 1]).norm();
+  const double turn = wrap_angle(goal_yaw - start_yaw);
+  double along = 0.0;
+  yaws[0] = wrap_angle(start_yaw);
+  for (size_t i = 1; i < w.size(); ++i) {
+    along += (w[i] - w[i - 1]).norm();
+    yaws[i] = wrap_angle(start_yaw + (total > 0 ? along / total : 1.0) * turn);
+  }
+  yaws.back() = wrap_angle(goal_yaw);
+  return yaws;
+}
+
+}  // namespace semx::planner

@@ -1,0 +1,336 @@
+#include "semx/planner/exploration_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "semx/planner/angles.hpp"
+#include "semx/planner/charge_model.hpp"
+#include "stopwatch.hpp"
+
+namespace semx::planner {
+
+const char* to_string(PlannerState s) {
+  switch (s) {
+    case PlannerState::kInit:
+      return "INIT";
+    case PlannerState::kPlanning:
+      return "PLANNING";
+    case PlannerState::kExecuting:
+      return "EXECUTING";
+    case PlannerState::kRecovering:
+      return "RECOVERING";
+    case PlannerState::kDone:
+      return "DONE";
+    case PlannerState::kFailed:
+      return "FAILED";
+  }
+  return "?";
+}
+
+ExplorationPlanner::ExplorationPlanner(const PlannerConfig& config)
+    : config_(config),
+      kind_(config.kind()),
+      strategy_(make_strategy(config)),
+      checker_(config.collision),
+      frontiers_(config.sampling.cluster_size),
+      gains_(config.gain),
+      rng_(static_cast<uint64_t>(config.seed)) {}
+
+void ExplorationPlanner::reset() {
+  strategy_->reset();
+  rng_.reseed(static_cast<uint64_t>(config_.seed));
+  pose_.reset();
+  state_ = PlannerState::kInit;
+  reason_.clear();
+  iteration_ = 0;
+  next_cycle_utime_ = -1;
+  no_goal_cycles_ = 0;
+  goal_ = Goal();
+  controller_trigger_ = controller_rejected_ = controller_holding_ = false;
+  init_reported_ = false;
+  pending_ = Pending();
+  last_status_ = StatusReport();
+  unobservable_.clear();
+  arrived_utime_ = -1;
+  if (grid_) frontiers_.reset(*grid_);
+  strategy_->on_map_reset();
+}
+
+void ExplorationPlanner::set_map(const mapper::StateGrid* grid) {
+  if (grid == grid_) return;
+  grid_ = grid;
+  checker_.set_grid(grid);
+  if (grid_) on_map_reset();
+}
+
+void ExplorationPlanner::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+  if (!grid_) return;
+  frontiers_.update(*grid_, changes);
+  strategy_->on_map_changes(changes);
+}
+
+void ExplorationPlanner::on_map_reset() {
+  if (!grid_) return;
+  frontiers_.reset(*grid_);
+  strategy_->on_map_reset();
+}
+
+void ExplorationPlanner::set_pose(const VehiclePose& pose) {
+  if (!pose.position.allFinite() || !std::isfinite(pose.yaw)) return;
+  pose_ = pose;
+}
+
+void ExplorationPlanner::on_controller_status(ControllerState state, int64_t plan_id) {
+  if (!goal_.valid || plan_id != plan_id_) return;  // about a plan we no longer fly
+  controller_holding_ = state == ControllerState::kHolding;
+  if (state == ControllerState::kBraking || state == ControllerState::kStaleInput ||
+      state == ControllerState::kRejected) {
+    if (!controller_trigger_) {
+      controller_trigger_ = true;
+      controller_rejected_ = state == ControllerState::kRejected;
+      controller_reason_ = state == ControllerState::kBraking      ? "controller braked"
+                           : state == ControllerState::kStaleInput ? "controller inputs stale"
+                                                                   : "controller rejected the path";
+    }
+  }
+}
+
+bool ExplorationPlanner::goal_reached(int64_t utime) {
+  if (!goal_.valid || !pose_) return false;
+  const bool within =
+      (pose_->position - goal_.position).norm() <= config_.loop.goal_tolerance &&
+      (controller_holding_ || yaw_distance(pose_->yaw, goal_.yaw) <= config_.loop.yaw_tolerance);
+  if (!within) {
+    arrived_utime_ = -1;
+    return false;
+  }
+  if (arrived_utime_ < 0) arrived_utime_ = utime;
+  return utime - arrived_utime_ >= static_cast<int64_t>(std::llround(config_.loop.dwell_s * 1e6));
+}
+
+void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
+  if (!grid_ || !pose_) return;
+  Stopwatch w;
+  std::vector<mapper::VoxelKey> keys;
+  GainStats stats;
+  gains_.set_ignored(&unobservable_);
+  gains_.evaluate(*grid_, pose_->position, pose_->yaw, &keys, &stats);
+  for (const mapper::VoxelKey& k : keys) unobservable_.insert(k);
+  if (!keys.empty()) strategy_->on_gain_invalidated(keys);
+  c.gain_evaluations += stats.evaluations;
+  c.rays += stats.rays;
+  c.ray_steps += stats.steps;
+  c.gain_ms += w.ms();
+}
+
+bool ExplorationPlanner::path_blocked() const {
+  if (!goal_.valid || !pose_ || goal_.waypoints.size() < 2) return false;
+  const std::vector<Eigen::Vector3d>& w = goal_.waypoints;
+  // The segment the vehicle is on: the nearest one to it.
+  size_t seg = 0;
+  double best = 1e300;
+  Eigen::Vector3d on = w[0];
+  for (size_t i = 0; i + 1 < w.size(); ++i) {
+    const Eigen::Vector3d d = w[i + 1] - w[i];
+    const double t =
+        d.squaredNorm() > 0 ? std::clamp((pose_->position - w[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    const Eigen::Vector3d q = w[i] + t * d;
+    const double dist = (q - pose_->position).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      seg = i;
+      on = q;
+    }
+  }
+  if (!checker_.root_edge_free(on, w[seg + 1])) return true;
+  for (size_t i = seg + 1; i + 1 < w.size(); ++i) {
+    if (!checker_.edge_free(w[i], w[i + 1])) return true;
+  }
+  return false;
+}
+
+StatusReport ExplorationPlanner::make_status(PlannerState state, const std::string& reason,
+                                             const CycleCounters& c, double charged, const Goal& best,
+                                             const RoadmapView* view) const {
+  StatusReport s;
+  s.planner = to_string(kind_);
+  s.state = state;
+  s.reason = reason;
+  s.iteration = iteration_;
+  if (view) {
+    s.num_nodes = static_cast<int32_t>(view->nodes.size());
+    s.num_edges = static_cast<int32_t>(view->edges.size());
+  }
+  if (best.valid) {
+    s.goal = best.position;
+    s.best_gain = best.gain;
+    s.best_reward = best.reward;
+    s.best_score = best.score;
+  } else if (goal_.valid) {
+    s.goal = goal_.position;
+  }
+  s.counters = c;
+  s.charged_s = charged;
+  return s;
+}
+
+ExplorationPlanner::Output ExplorationPlanner::tick(int64_t utime) {
+  Output out;
+  if (pending_.active) {
+    if (utime >= pending_.ready_utime) release(out, utime);
+    return out;
+  }
+  if (state_ == PlannerState::kDone) return out;
+  if (!grid_ || !pose_) {
+    if (!init_reported_) {
+      init_reported_ = true;
+      last_status_ = make_status(PlannerState::kInit, !grid_ ? "waiting for the map" : "waiting for odometry",
+                                 CycleCounters(), 0.0, Goal(), nullptr);
+      out.status = last_status_;
+    }
+    return out;
+  }
+  if (next_cycle_utime_ >= 0 && utime < next_cycle_utime_) return out;
+  run_cycle(utime);
+  if (pending_.active && utime >= pending_.ready_utime) release(out, utime);
+  return out;
+}
+
+void ExplorationPlanner::run_cycle(int64_t utime) {
+  Stopwatch total;
+  CycleCounters c;
+  ++iteration_;
+  checker_.reset_counters();
+  PlanContext ctx;
+  ctx.grid = grid_;
+  ctx.pose = *pose_;
+  ctx.regions = &regions_;
+  ctx.frontiers = &frontiers_;
+  ctx.unobservable = &unobservable_;
+  ctx.cycle = iteration_;
+  ctx.recovering = no_goal_cycles_ > 0;
+  ctx.rng = &rng_;
+  ctx.counters = &c;
+
+  bool need = !goal_.valid;
+  std::string why = goal_.valid ? "" : "no goal";
+  if (goal_.valid) {
+    if (controller_trigger_) {
+      need = true;
+      why = controller_reason_;
+      if (controller_rejected_) strategy_->reject_goal(goal_, iteration_ + config_.loop.blacklist_cycles);
+    } else if (goal_reached(utime)) {
+      need = true;
+      why = "goal reached";
+      mark_unobservable(c);
+      strategy_->reject_goal(goal_, iteration_ + config_.loop.visited_cycles);
+    } else if (path_blocked()) {
+      need = true;
+      why = "path blocked";
+    }
+  }
+  controller_trigger_ = controller_rejected_ = false;
+
+  const bool run = need || !strategy_->receding_horizon();
+  PlanOutcome o;
+  if (run) o = strategy_->plan(ctx);
+  if (run && !need) {
+    const std::optional<double> current = strategy_->goal_score(ctx, goal_);
+    if (!current) {
+      need = true;
+      why = "goal no longer informative";
+    } else if (o.goal.valid && o.goal.node != goal_.node &&
+               o.goal.score > config_.loop.hysteresis * *current) {
+      need = true;
+      std::ostringstream s;
+      s << "better goal (node " << o.goal.node << " score " << o.goal.score << " vs node " << goal_.node
+        << " " << *current << ")";
+      why = s.str();
+    }
+  }
+
+  Pending p;
+  p.active = true;
+  PlannerState next = state_;
+  std::string reason;
+  if (need && o.goal.valid) {
+    p.has_path = true;
+    p.goal = o.goal;
+    no_goal_cycles_ = 0;
+    next = PlannerState::kExecuting;
+    std::ostringstream s;
+    s << why << ": goal (" << o.goal.position.x() << ", " << o.goal.position.y() << ", "
+      << o.goal.position.z() << ") gain " << o.goal.gain << " reward " << o.goal.reward << " score "
+      << o.goal.score;
+    reason = s.str();
+  } else if (need) {
+    if (why == "path blocked") {
+      // Nothing else to fly and the path ahead is blocked: hold where the vehicle is.
+      p.has_path = true;
+      p.goal.valid = false;
+      p.goal.position = pose_->position;
+      p.goal.yaw = pose_->yaw;
+      p.goal.waypoints = {pose_->position};
+      p.goal.yaws = {pose_->yaw};
+    }
+    goal_ = Goal();  // nothing to fly
+    ++no_goal_cycles_;
+    next = no_goal_cycles_ >= config_.loop.done_cycles ? PlannerState::kDone : PlannerState::kRecovering;
+    reason = next == PlannerState::kDone ? o.reason : why + ": " + o.reason;
+  } else {
+    next = PlannerState::kExecuting;
+    reason = "flying to the goal";
+  }
+
+  c.box_checks += checker_.box_checks();
+  c.total_ms = total.ms();
+  c.cpu_ms = total.cpu_ms();
+  const double charged = charged_seconds(c, config_.charge);
+  p.ready_utime = utime + static_cast<int64_t>(std::llround(charged * 1e6));
+  if (run || next != state_) {
+    p.roadmap = strategy_->roadmap(p.has_path ? &p.goal : (goal_.valid ? &goal_ : nullptr));
+    p.roadmap->iteration = iteration_;
+    p.status = make_status(next, reason, c, charged, o.goal, &*p.roadmap);
+  }
+  state_ = next == PlannerState::kExecuting && p.has_path ? PlannerState::kPlanning : next;
+  reason_ = reason;
+  pending_ = std::move(p);
+  const int64_t period = static_cast<int64_t>(std::llround(1e6 / config_.rate_hz));
+  next_cycle_utime_ = std::max(pending_.ready_utime, utime + period);
+}
+
+void ExplorationPlanner::release(Output& out, int64_t utime) {
+  Pending p = std::move(pending_);
+  pending_ = Pending();
+  if (p.has_path) {
+    if (pose_ && (pose_->position - p.goal.waypoints.front()).norm() > config_.loop.max_start_offset) {
+      // The vehicle moved on while this was planned: plan again from where it is now.
+      goal_ = Goal();
+      next_cycle_utime_ = utime;
+      state_ = PlannerState::kPlanning;
+      if (p.status) {
+        p.status->state = state_;
+        p.status->reason = "dropped a path the vehicle has left; replanning";
+      }
+    } else {
+      goal_ = p.goal;  // invalid for a hold: the next cycle plans again
+      controller_holding_ = false;
+      arrived_utime_ = -1;
+      PlannedPath path;
+      path.plan_id = ++plan_id_;
+      path.waypoints = p.goal.waypoints;
+      path.yaws = p.goal.yaws;
+      out.path = std::move(path);
+      if (goal_.valid) state_ = PlannerState::kExecuting;
+      if (p.status) p.status->state = state_;
+    }
+  }
+  if (p.status) {
+    last_status_ = *p.status;
+    out.status = std::move(p.status);
+  }
+  if (p.roadmap) out.roadmap = std::move(p.roadmap);
+}
+
+}  // namespace semx::planner

@@ -1,0 +1,310 @@
+#include "semx/planner/gain_evaluator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "semx/mapper/raycast.hpp"
+#include "semx/planner/angles.hpp"
+
+namespace semx::planner {
+
+using mapper::VoxelKey;
+using mapper::VoxelState;
+
+int64_t NodeGain::total_voxels() const {
+  int64_t n = 0;
+  for (const auto& c : bin_count) n += c[0] + c[1] + c[2];
+  return n;
+}
+
+GainEvaluator::GainEvaluator(const GainConfig& config) : config_(config) {
+  const int bins = config_.yaw_bins;
+  window_ = std::clamp(static_cast<int>(std::lround(config_.horizontal_fov() / (2.0 * kPi / bins))), 1, bins);
+  const double half_vfov = 0.5 * config_.vertical_fov();
+  // The image's vertical extent shrinks off-axis: at horizontal angle a from the optical axis a
+  // pixel row sees elevations up to atan(tan(vfov/2) cos a). Counting only what every column of
+  // the window sees (a = hfov/2) keeps the model conservative: a voxel counted for a window is
+  // seen when the camera looks along that window's centre (up to occlusion).
+  tan_half_vfov_ = std::tan(half_vfov) * std::cos(std::min(0.5 * config_.horizontal_fov(), 0.5 * kPi - 1e-6));
+  const int na = config_.rays_azimuth, ne = config_.rays_elevation;
+  directions_.reserve(static_cast<size_t>(na) * ne);
+  for (int e = 0; e < ne; ++e) {
+    const double max_el = std::atan(tan_half_vfov_);
+    const double el = ne == 1 ? 0.0 : -max_el + 2.0 * max_el * e / (ne - 1);
+    for (int a = 0; a < na; ++a) {
+      const double az = -kPi + (a + 0.5) * 2.0 * kPi / na;
+      directions_.emplace_back(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      direction_bin_.push_back(bin_of(az));
+    }
+  }
+  for (int b = 0; b < bins; ++b) {
+    const double a = -kPi + b * bin_width();
+    bin_boundary_.emplace_back(std::cos(a), std::sin(a));
+  }
+}
+
+int GainEvaluator::bin_near(const Eigen::Vector3d& c, int b) const {
+  // Bin b holds the azimuths [u_b, u_b+1): c is at or after boundary b and before boundary b + 1
+  // (two cross products; bins are narrower than pi). Azimuth exactly pi is the last bin, as in
+  // bin_of(atan2).
+  const int bins = config_.yaw_bins;
+  if (bins == 1) return 0;
+  if (c.y() == 0.0 && c.x() < 0.0) return bins - 1;
+  auto after = [&](int boundary) {
+    const Eigen::Vector2d& u = bin_boundary_[static_cast<size_t>(boundary)];
+    return u.x() * c.y() - u.y() * c.x() >= 0.0;
+  };
+  for (int guard = 0; guard < bins; ++guard) {
+    const int next = b + 1 == bins ? 0 : b + 1;
+    if (!after(b)) {
+      b = b == 0 ? bins - 1 : b - 1;
+    } else if (after(next)) {
+      b = next;
+    } else {
+      return b;
+    }
+  }
+  return bin_of(std::atan2(c.y(), c.x()));
+}
+
+double GainEvaluator::bin_width() const { return 2.0 * kPi / config_.yaw_bins; }
+
+double GainEvaluator::window_yaw(int j) const { return wrap_angle(-kPi + (j + 0.5 * window_) * bin_width()); }
+
+int GainEvaluator::bin_of(double azimuth) const {
+  const int b = static_cast<int>(std::floor((azimuth + kPi) / bin_width()));
+  return std::clamp(b, 0, config_.yaw_bins - 1);
+}
+
+bool GainEvaluator::classify(mapper::StateGrid::Reader& r, const VoxelKey& k, GainVoxel& kind) {
+  if (r.state(k) != VoxelState::kUnknown) return false;
+  bool free = false, occupied = false;
+  for (const VoxelKey& d : mapper::kFaceNeighbours) {
+    const VoxelState s = r.state(k + d);
+    free |= s == VoxelState::kFree;
+    occupied |= s == VoxelState::kOccupied;
+  }
+  kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
+  return true;
+}
+
+bool GainEvaluator::in_sector(const Eigen::Vector3d& c) const {
+  const double r2 = c.squaredNorm();
+  if (r2 < config_.min_range * config_.min_range || r2 > config_.max_range * config_.max_range) return false;
+  // |z| <= tan(vfov/2) * horizontal distance, squared.
+  const double h2 = c.x() * c.x() + c.y() * c.y();
+  return c.z() * c.z() <= tan_half_vfov_ * tan_half_vfov_ * h2 * (1.0 + 1e-12);
+}
+
+void GainEvaluator::add(NodeGain& g, int b, GainVoxel kind) const {
+  const int i = static_cast<int>(kind);
+  const double w[3] = {config_.weight_unknown, config_.weight_frontier, config_.weight_surface};
+  g.bin_gain[static_cast<size_t>(b)] += static_cast<float>(w[i]);
+  ++g.bin_count[static_cast<size_t>(b)][static_cast<size_t>(i)];
+}
+
+void GainEvaluator::finish(NodeGain& g) const {
+  const int bins = config_.yaw_bins;
+  std::vector<double> sums(static_cast<size_t>(bins), 0.0);
+  double best = -1.0;
+  for (int j = 0; j < bins; ++j) {
+    double s = 0.0;
+    for (int w = 0; w < window_; ++w) s += g.bin_gain[static_cast<size_t>((j + w) % bins)];
+    sums[static_cast<size_t>(j)] = s;
+    best = std::max(best, s);
+  }
+  // Several windows often tie (a small cluster fits in many): take the middle of the first run
+  // of tied windows (circularly), the one that centres the cluster.
+  auto tied = [&](int j) { return sums[static_cast<size_t>(((j % bins) + bins) % bins)] >= best - 1e-9; };
+  int start = 0;
+  while (start < bins && !tied(start)) ++start;
+  if (start == 0 && tied(bins - 1)) {
+    while (start > -bins + 1 && tied(start - 1)) --start;  // the run wraps around bin 0
+  }
+  int length = 0;
+  while (length < bins && tied(start + length)) ++length;
+  const int best_j = (((start + length / 2) % bins) + bins) % bins;
+  g.best_window = best_j;
+  g.gain = std::max(0.0, best);
+  g.yaw = window_yaw(best_j);
+  g.counts = {0, 0, 0};
+  for (int w = 0; w < window_; ++w) {
+    const auto& c = g.bin_count[static_cast<size_t>((best_j + w) % bins)];
+    for (int i = 0; i < 3; ++i) g.counts[static_cast<size_t>(i)] += c[static_cast<size_t>(i)];
+  }
+  g.valid = true;
+}
+
+int GainEvaluator::window_of(double yaw) const {
+  // Window j is centred at -pi + (j + W/2) * width.
+  const int bins = config_.yaw_bins;
+  const int j = static_cast<int>(std::lround((wrap_angle(yaw) + kPi) / bin_width() - 0.5 * window_));
+  return ((j % bins) + bins) % bins;
+}
+
+double GainEvaluator::gain_at_yaw(const NodeGain& g, double yaw) const {
+  if (!g.valid) return 0.0;
+  const int bins = config_.yaw_bins;
+  const int j = window_of(yaw);
+  double s = 0.0;
+  for (int w = 0; w < window_; ++w) s += g.bin_gain[static_cast<size_t>((((j + w) % bins) + bins) % bins)];
+  return s;
+}
+
+NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats) {
+  return evaluate(grid, p, 0.0, nullptr, stats);
+}
+
+NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
+                                 std::vector<VoxelKey>* counted, GainStats* stats) {
+  const int bins = config_.yaw_bins;
+  const int first = counted ? window_of(yaw) : 0;
+  auto in_window = [&](int b) { return ((b - first) % bins + bins) % bins < window_; };
+  NodeGain g;
+  g.bin_gain.assign(static_cast<size_t>(config_.yaw_bins), 0.0f);
+  g.bin_count.assign(static_cast<size_t>(config_.yaw_bins), {0, 0, 0});
+  const mapper::KeyMath& km = grid.keys();
+  VoxelKey origin;
+  if (!p.allFinite() || !km.key(p, origin)) {
+    finish(g);
+    return g;
+  }
+  const double res = grid.resolution();
+  const double reach = config_.max_range + res;
+  if (seen_res_ != res || seen_.empty()) {
+    seen_res_ = res;
+    hx_ = static_cast<int>(std::ceil((reach + res) / res)) + 1;
+    const double sin_el = std::min(1.0, std::sin(0.5 * config_.vertical_fov()));
+    hz_ = static_cast<int>(std::ceil(((reach + res) * sin_el) / res)) + 2;
+    const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
+    seen_.assign((bits + 63) / 64, 0);
+  } else {
+    std::memset(seen_.data(), 0, seen_.size() * sizeof(uint64_t));
+  }
+  const int nx = 2 * hx_ + 1;
+  mapper::StateGrid::Reader neighbour_reader = grid.reader();
+  const double inv = 1.0 / res;
+  const Eigen::Vector3d o = p * inv;  // in voxel units
+  int64_t steps = 0;
+  for (size_t ray = 0; ray < directions_.size(); ++ray) {
+    const Eigen::Vector3d& d = directions_[ray];
+    const int ray_bin = direction_bin_[ray];
+    // 3-D DDA (Amanatides & Woo) in voxel units, t in metres along the unit direction; the block
+    // pointer is looked up only when the walk enters another 16^3 block.
+    VoxelKey k = origin;
+    int step[3];
+    double t_max[3], t_delta[3];
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] > 0) {
+        step[a] = 1;
+        t_max[a] = (k[a] + 1 - o[a]) * res / d[a];
+        t_delta[a] = res / d[a];
+      } else if (d[a] < 0) {
+        step[a] = -1;
+        t_max[a] = (k[a] - o[a]) * res / d[a];
+        t_delta[a] = -res / d[a];
+      } else {
+        step[a] = 0;
+        t_max[a] = t_delta[a] = std::numeric_limits<double>::infinity();
+      }
+    }
+    VoxelKey block = mapper::block_of(k);
+    const mapper::VoxelBlock* b = grid.find_block(block);
+    for (;;) {
+      ++steps;
+      const VoxelKey kb = mapper::block_of(k);
+      if (kb != block) {
+        block = kb;
+        b = grid.find_block(block);
+      }
+      const VoxelState s = b ? b->state[static_cast<size_t>(mapper::local_index(k))] : VoxelState::kUnknown;
+      if (s == VoxelState::kOccupied) break;
+      if (s == VoxelState::kUnknown) {
+        const int dx = k.x - origin.x + hx_, dy = k.y - origin.y + hx_, dz = k.z - origin.z + hz_;
+        if (dx >= 0 && dy >= 0 && dz >= 0 && dx < nx && dy < nx && dz <= 2 * hz_) {
+          const size_t bit =
+              static_cast<size_t>(dx) + static_cast<size_t>(nx) * (dy + static_cast<size_t>(nx) * dz);
+          uint64_t& word = seen_[bit >> 6];
+          const uint64_t mask = uint64_t{1} << (bit & 63);
+          if (!(word & mask)) {
+            word |= mask;
+            const Eigen::Vector3d c = km.center(k) - p;
+            GainVoxel kind = GainVoxel::kUnknown;
+            bool known_kind = false;
+            const int lx = k.x & mapper::kBlockMask, ly = k.y & mapper::kBlockMask,
+                      lz = k.z & mapper::kBlockMask;
+            if (lx > 0 && ly > 0 && lz > 0 && lx < mapper::kBlockMask && ly < mapper::kBlockMask &&
+                lz < mapper::kBlockMask) {
+              // All six neighbours are in this block: read them directly (an unallocated block is
+              // all unknown, so its inner voxels are "normal").
+              known_kind = true;
+              if (b) {
+                const size_t i = static_cast<size_t>(mapper::local_index(k));
+                constexpr size_t dy = mapper::kBlockSize, dz = mapper::kBlockSize * mapper::kBlockSize;
+                const VoxelState n[6] = {b->state[i - 1],  b->state[i + 1],  b->state[i - dy],
+                                         b->state[i + dy], b->state[i - dz], b->state[i + dz]};
+                bool free = false, occupied = false;
+                for (const VoxelState v : n) {
+                  free |= v == VoxelState::kFree;
+                  occupied |= v == VoxelState::kOccupied;
+                }
+                kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
+              }
+            }
+            if (in_sector(c) && !(ignored_ && ignored_->count(k)) &&
+                (known_kind || classify(neighbour_reader, k, kind))) {
+              const int bin = bin_near(c, ray_bin);
+              add(g, bin, kind);
+              if (counted && in_window(bin)) counted->push_back(k);
+            }
+          }
+        }
+      }
+      const int a = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+      if (t_max[a] > reach) break;
+      k[a] += step[a];
+      t_max[a] += t_delta[a];
+    }
+  }
+  if (stats) {
+    ++stats->evaluations;
+    stats->rays += static_cast<int64_t>(directions_.size());
+    stats->steps += steps;
+  }
+  finish(g);
+  return g;
+}
+
+NodeGain GainEvaluator::evaluate_exact(const mapper::StateGrid& grid, const Eigen::Vector3d& p) const {
+  NodeGain g;
+  g.bin_gain.assign(static_cast<size_t>(config_.yaw_bins), 0.0f);
+  g.bin_count.assign(static_cast<size_t>(config_.yaw_bins), {0, 0, 0});
+  const mapper::KeyMath& km = grid.keys();
+  VoxelKey origin;
+  if (!p.allFinite() || !km.key(p, origin)) {
+    finish(g);
+    return g;
+  }
+  const int h = static_cast<int>(std::ceil(config_.max_range / grid.resolution())) + 1;
+  mapper::StateGrid::Reader r = grid.reader();
+  for (int z = -h; z <= h; ++z) {
+    for (int y = -h; y <= h; ++y) {
+      for (int x = -h; x <= h; ++x) {
+        const VoxelKey k{origin.x + x, origin.y + y, origin.z + z};
+        const Eigen::Vector3d c = km.center(k) - p;
+        if (!in_sector(c)) continue;
+        GainVoxel kind;
+        if (ignored_ && ignored_->count(k)) continue;
+        if (!classify(r, k, kind)) continue;
+        if (!grid.is_visible(p, km.center(k), false)) continue;
+        add(g, bin_of(std::atan2(c.y(), c.x())), kind);
+      }
+    }
+  }
+  finish(g);
+  return g;
+}
+
+}  // namespace semx::planner

@@ -1,0 +1,22 @@
+#include "semx/planner/aep_strategy.hpp"
+#include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/nbv_strategy.hpp"
+#include "semx/planner/strategy.hpp"
+
+namespace semx::planner {
+
+std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
+  switch (config.kind()) {
+    case PlannerKind::kSemanticDep:
+      return std::make_unique<DepStrategy>(config, true);
+    case PlannerKind::kDep:
+      return std::make_unique<DepStrategy>(config, false);
+    case PlannerKind::kNbv:
+      return std::make_unique<NbvStrategy>(config);
+    case PlannerKind::kAep:
+      return std::make_unique<AepStrategy>(config);
+  }
+  return nullptr;
+}
+
+}  // namespace semx::planner

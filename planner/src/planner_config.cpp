@@ -1,0 +1,135 @@
+#include "semx/planner/planner_config.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace semx::planner {
+
+const char* to_string(PlannerKind k) {
+  switch (k) {
+    case PlannerKind::kSemanticDep:
+      return "semantic-dep";
+    case PlannerKind::kDep:
+      return "dep";
+    case PlannerKind::kNbv:
+      return "nbv";
+    case PlannerKind::kAep:
+      return "aep";
+  }
+  return "?";
+}
+
+PlannerKind parse_planner_kind(const std::string& name) {
+  if (name == "semantic-dep") return PlannerKind::kSemanticDep;
+  if (name == "dep") return PlannerKind::kDep;
+  if (name == "nbv") return PlannerKind::kNbv;
+  if (name == "aep") return PlannerKind::kAep;
+  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep)");
+}
+
+double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
+double GainConfig::vertical_fov() const { return 2.0 * std::atan2(0.5 * image_height, fy); }
+
+namespace {
+
+void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& out, double lo, double hi) {
+  std::vector<double> v{out.x(), out.y(), out.z()};
+  m.get(key, v);
+  if (v.size() != 3) m.fail(key, "expected 3 values");
+  for (double x : v) {
+    if (!(x >= lo && x <= hi))
+      m.fail(key, "values must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  out = Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+void load(runtime::ConfigMap& m, PlannerConfig& c) {
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep"});
+  m.get("seed", c.seed);
+  m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
+
+  auto co = m.child("collision");
+  get_vec3(co, "vehicle_size", c.collision.vehicle_size, 0.01, 10.0);
+  co.get("margin", c.collision.margin, 0.0, 5.0);
+  co.get("clearance", c.collision.clearance, 0.0, 5.0);
+  co.get("edge_step", c.collision.edge_step, 0.005, 1.0);
+  co.get("root_escape_radius", c.collision.root_escape_radius, 0.0, 5.0);
+
+  auto s = m.child("sampling");
+  s.get("samples", c.sampling.samples, 1, 100000);
+  s.get("max_attempts_factor", c.sampling.max_attempts_factor, 1, 1000);
+  s.get("max_draws_factor", c.sampling.max_draws_factor, 1, 100000);
+  s.get("local_radius", c.sampling.local_radius, 0.1, 100.0);
+  s.get("local_height", c.sampling.local_height, 0.0, 100.0);
+  s.get("frontier_fraction", c.sampling.frontier_fraction, 0.0, 1.0);
+  s.get("frontier_radius", c.sampling.frontier_radius, 0.05, 100.0);
+  s.get("min_node_distance", c.sampling.min_node_distance, 0.0, 100.0);
+  s.get("z_min", c.sampling.z_min, -1000.0, 1000.0);
+  s.get("z_max", c.sampling.z_max, -1000.0, 1000.0);
+  s.get("cluster_size", c.sampling.cluster_size, 0.1, 100.0);
+  s.get("min_cluster_voxels", c.sampling.min_cluster_voxels, 1, 1000000);
+  if (!(c.sampling.z_min < c.sampling.z_max)) s.fail("z_max", "must be above z_min");
+
+  auto r = m.child("roadmap");
+  r.get("k_nearest", c.roadmap.k_nearest, 1, 1000);
+  r.get("max_edge_length", c.roadmap.max_edge_length, 0.05, 100.0);
+
+  auto g = m.child("gain");
+  g.get("image_width", c.gain.image_width, 1, 100000);
+  g.get("image_height", c.gain.image_height, 1, 100000);
+  g.get("fx", c.gain.fx, 1e-3, 1e6);
+  g.get("fy", c.gain.fy, 1e-3, 1e6);
+  g.get("min_range", c.gain.min_range, 0.0, 100.0);
+  g.get("max_range", c.gain.max_range, 0.05, 100.0);
+  g.get("weight_unknown", c.gain.weight_unknown, 0.0, 1e6);
+  g.get("weight_frontier", c.gain.weight_frontier, 0.0, 1e6);
+  g.get("weight_surface", c.gain.weight_surface, 0.0, 1e6);
+  g.get("yaw_bins", c.gain.yaw_bins, 1, 360);
+  g.get("rays_azimuth", c.gain.rays_azimuth, 1, 100000);
+  g.get("rays_elevation", c.gain.rays_elevation, 1, 100000);
+  g.get("min_gain", c.gain.min_gain, 0.0, 1e12);
+  if (!(c.gain.min_range < c.gain.max_range)) g.fail("max_range", "must be above min_range");
+  if (c.gain.rays_azimuth % c.gain.yaw_bins != 0) g.fail("rays_azimuth", "must be a multiple of yaw_bins");
+
+  auto k = m.child("cost");
+  k.get("velocity", c.cost.velocity, 1e-3, 100.0);
+  k.get("yaw_rate", c.cost.yaw_rate, 1e-3, 100.0);
+  k.get("yaw_weight", c.cost.yaw_weight, 0.0, 1e6);
+  k.get("min_time", c.cost.min_time, 1e-6, 1e6);
+
+  auto l = m.child("loop");
+  l.get("goal_tolerance", c.loop.goal_tolerance, 0.0, 100.0);
+  l.get("yaw_tolerance", c.loop.yaw_tolerance, 0.0, 7.0);
+  l.get("dwell_s", c.loop.dwell_s, 0.0, 3600.0);
+  l.get("hysteresis", c.loop.hysteresis, 1.0, 1e6);
+  l.get("done_cycles", c.loop.done_cycles, 1, 1000000);
+  l.get("blacklist_cycles", c.loop.blacklist_cycles, 0, 1000000);
+  l.get("visited_cycles", c.loop.visited_cycles, 0, 1000000);
+  l.get("max_start_offset", c.loop.max_start_offset, 0.0, 100.0);
+
+  auto ch = m.child("charge");
+  ch.get("base_s", c.charge.base_s, 0.0, 1e3);
+  ch.get("per_box_check_s", c.charge.per_box_check_s, 0.0, 1.0);
+  ch.get("per_gain_node_s", c.charge.per_gain_node_s, 0.0, 1.0);
+  ch.get("per_ray_step_s", c.charge.per_ray_step_s, 0.0, 1.0);
+  ch.get("per_search_node_s", c.charge.per_search_node_s, 0.0, 1.0);
+  ch.get("scale", c.charge.scale, 0.0, 1e6);
+
+  auto n = m.child("nbv");
+  n.get("step", c.nbv.step, 0.05, 100.0);
+  n.get("lambda", c.nbv.lambda, 0.0, 100.0);
+  n.get("radius", c.nbv.radius, 0.1, 100.0);
+
+  auto a = m.child("aep");
+  a.get("step", c.aep.step, 0.05, 100.0);
+  a.get("rewire_radius", c.aep.rewire_radius, 0.0, 100.0);
+  a.get("lambda", c.aep.lambda, 0.0, 100.0);
+  a.get("radius", c.aep.radius, 0.1, 100.0);
+  a.get("cache_radius", c.aep.cache_radius, 0.0, 100.0);
+  a.get("g_zero", c.aep.g_zero, 0.0, 1e12);
+}
+
+}  // namespace semx::planner

@@ -1,0 +1,23 @@
+#include "semx/planner/semantic_reward.hpp"
+
+#include <cmath>
+
+namespace semx::planner {
+
+double region_reward(const Eigen::Vector3d& p, const SemanticRegion& s) {
+  if (!s.active || !(s.radius > 0) || !std::isfinite(s.radius) || !std::isfinite(s.weight) ||
+      !(s.weight > 0) || !s.centroid.allFinite() || !p.allFinite()) {
+    return 0.0;
+  }
+  const double d = (p - s.centroid).norm();
+  if (d > s.radius) return 0.0;
+  return s.weight * (1.0 - d / s.radius);
+}
+
+double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions) {
+  double r = 0.0;
+  for (const SemanticRegion& s : regions) r += region_reward(p, s);
+  return r;
+}
+
+}  // namespace semx::planner

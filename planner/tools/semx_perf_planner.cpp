@@ -1,0 +1,245 @@
+// semx-perf-planner: planning-cycle time over whole explorations of synthetic worlds (the
+// ExplorationSim closed loop: ideal vehicle, camera model, no processes), one `name: value unit`
+// line per figure (./semx perf planner).
+//
+//   semx-perf-planner [--world apartment|two_rooms|env1|env2|env3] [--planner NAME] [--samples N]
+//                     [--seed N] [--runs N] [--max-time S] [--set KEY=VALUE]... [--fit] [--verbose]
+//
+// env1-3 (the simulator's shipped worlds, voxelised by its ground truth) need the simulator
+// library at build time. --fit prints the least-squares charge coefficients of the cycle's wall
+// time against the work counters (docs/planner.md, "Planning time").
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "semx/planner/charge_model.hpp"
+#include "semx/planner/exploration_planner.hpp"
+#include "semx/planner/exploration_sim.hpp"
+#include "semx/planner/synthetic_world.hpp"
+#include "semx/runtime/args.hpp"
+#include "semx/runtime/config.hpp"
+
+#ifdef SEMX_PERF_WITH_SIMULATOR
+#include "semx/simulator/ground_truth.hpp"
+#include "semx/simulator/world.hpp"
+#endif
+
+using namespace semx::planner;
+using namespace semx::runtime;
+
+namespace {
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * (static_cast<double>(v.size()) - 1);
+  const size_t i = static_cast<size_t>(std::floor(pos));
+  const size_t j = std::min(v.size() - 1, i + 1);
+  return v[i] + (pos - static_cast<double>(i)) * (v[j] - v[i]);
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resolution) {
+  if (name == "apartment") return std::make_unique<SyntheticWorld>(SyntheticWorld::apartment(resolution));
+  if (name == "two_rooms") return std::make_unique<SyntheticWorld>(SyntheticWorld::two_rooms(resolution));
+#ifdef SEMX_PERF_WITH_SIMULATOR
+  const semx::simulator::World w = semx::simulator::load_world(semx::simulator::shipped_world_path(name));
+  auto gt = std::make_shared<semx::simulator::GroundTruth>(w, resolution);
+  Box interior{w.bounds.min, w.bounds.max};
+  auto world = std::make_unique<SyntheticWorld>(
+      resolution, interior,
+      [gt](const semx::mapper::VoxelKey& k) {
+        const Eigen::Vector3i key(k.x, k.y, k.z);
+        return gt->in_grid(key) && gt->cell(key) == semx::simulator::GroundTruth::kOccupied;
+      },
+      w.start.position, w.name);
+  std::vector<Box> objects;
+  for (const semx::simulator::ObjectInfo& o : gt->objects())
+    objects.push_back({o.center - 0.5 * o.extent, o.center + 0.5 * o.extent});
+  world->set_objects(std::move(objects));
+  return world;
+#else
+  throw ArgError("unknown world '" + name + "' (apartment, two_rooms; env1-3 need the simulator library)");
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("semx-perf-planner", [&] {
+    std::string world_name = "apartment", planner_name, config_file;
+    int64_t samples = 0, seed = -1, runs = 1;
+    double max_time = 900.0, semantic_weight = 0.0;
+    bool fit = false, verbose = false;
+    std::vector<std::string> overrides;
+    ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
+    p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
+        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep", &planner_name)
+        .option("samples", "N", "sampling density (default: config, 45)", &samples)
+        .option("seed", "N", "first seed (runs use seed, seed+1, ...)", &seed)
+        .option("runs", "N", "explorations (default 1)", &runs)
+        .option("max-time", "S", "simulated seconds per exploration at most (default 900)", &max_time)
+        .option("semantic-weight", "W",
+                "emulated semantics: every object of the world is a region of this weight (default 0: none)",
+                &semantic_weight)
+        .option("config", "FILE", "planner YAML", &config_file)
+        .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
+        .flag("fit", "print least-squares charge coefficients", &fit)
+        .flag("verbose", "one line per cycle", &verbose);
+    if (!p.parse(argc, argv)) return 0;
+    if (!planner_name.empty()) overrides.push_back("planner=" + planner_name);
+    if (samples > 0) overrides.push_back("sampling.samples=" + std::to_string(samples));
+    PlannerConfig config = load_config<PlannerConfig>(config_file, overrides);
+    if (seed >= 0) config.seed = seed;
+    const double resolution = 0.1;
+    const auto world = make_world(world_name, resolution);
+
+    std::vector<double> cycle_cpu_ms, cycle_ms, sample_ms, connect_ms, gain_ms, search_ms, charged_ms, evals;
+    std::vector<CycleCounters> counters;
+    double coverage = 0, time_s = 0, distance = 0, time_85 = 0, objects_time = 0;
+    int64_t reached_85 = 0, objects_done = 0, objects_completed = 0;
+    int64_t collisions = 0, done = 0, paths = 0;
+    const auto wall0 = std::chrono::steady_clock::now();
+    for (int64_t run = 0; run < runs; ++run) {
+      PlannerConfig c = config;
+      c.seed = config.seed + run;
+      ExplorationPlanner planner(c);
+      ExplorationSimOptions o;
+      o.max_time = max_time;
+      o.semantic_weight = semantic_weight;
+      ExplorationSim sim(*world, planner, o);
+      const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
+        if (verbose && out.status && out.status->iteration > 0) {
+          const StatusReport& s = *out.status;
+          std::printf(
+              "t=%7.2f it=%4lld %-10s nodes=%4d ms=%6.2f (s %.2f c %.2f g %.2f q %.2f) evals=%lld "
+              "charged=%.1fms %s\n",
+              t, static_cast<long long>(s.iteration), to_string(s.state), s.num_nodes, s.counters.total_ms,
+              s.counters.sample_ms, s.counters.connect_ms, s.counters.gain_ms, s.counters.search_ms,
+              static_cast<long long>(s.counters.gain_evaluations), 1e3 * s.charged_s, s.reason.c_str());
+        }
+      });
+      for (size_t i = 0; i < r.cycle_ms.size(); ++i) {
+        const CycleCounters& k = r.counters[i];
+        cycle_ms.push_back(r.cycle_ms[i]);
+        cycle_cpu_ms.push_back(k.cpu_ms);
+        sample_ms.push_back(k.sample_ms);
+        connect_ms.push_back(k.connect_ms);
+        gain_ms.push_back(k.gain_ms);
+        search_ms.push_back(k.search_ms);
+        charged_ms.push_back(1e3 * charged_seconds(k, c.charge));
+        evals.push_back(static_cast<double>(k.gain_evaluations));
+        counters.push_back(k);
+      }
+      coverage += r.coverage;
+      objects_completed += r.objects_completed;
+      if (r.objects_time >= 0) {
+        objects_time += r.objects_time;
+        ++objects_done;
+      }
+      if (r.time_85 >= 0) {
+        time_85 += r.time_85;
+        ++reached_85;
+      }
+      time_s += r.time_s;
+      distance += r.distance;
+      collisions += r.collisions;
+      paths += r.paths;
+      done += r.done ? 1 : 0;
+      if (verbose)
+        std::printf("run %lld: %s after %.1f s: %s\n", static_cast<long long>(run),
+                    r.done ? "DONE" : "stopped", r.time_s, r.reason.c_str());
+    }
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    const double n = static_cast<double>(runs);
+    std::printf("world: %s\n", world->name().c_str());
+    std::printf("planner: %s\n", config.planner.c_str());
+    std::printf("samples: %d\n", config.sampling.samples);
+    std::printf("runs: %lld\n", static_cast<long long>(runs));
+    std::printf("cycles: %zu\n", cycle_ms.size());
+    std::printf("cycle_cpu_p50: %.2f ms\n", percentile(cycle_cpu_ms, 0.5));
+    std::printf("cycle_cpu_p95: %.2f ms\n", percentile(cycle_cpu_ms, 0.95));
+    std::printf("cycle_cpu_max: %.2f ms\n", percentile(cycle_cpu_ms, 1.0));
+    std::printf("cycle_p50: %.2f ms\n", percentile(cycle_ms, 0.5));
+    std::printf("cycle_p95: %.2f ms\n", percentile(cycle_ms, 0.95));
+    std::printf("cycle_max: %.2f ms\n", percentile(cycle_ms, 1.0));
+    std::printf("cycle_mean: %.2f ms\n", mean(cycle_ms));
+    std::printf("sample_mean: %.2f ms\n", mean(sample_ms));
+    std::printf("connect_mean: %.2f ms\n", mean(connect_ms));
+    std::printf("gain_mean: %.2f ms\n", mean(gain_ms));
+    std::printf("search_mean: %.2f ms\n", mean(search_ms));
+    std::printf("gain_evaluations_mean: %.1f per cycle\n", mean(evals));
+    std::printf("charged_mean: %.2f ms\n", mean(charged_ms));
+    std::printf("charged_p95: %.2f ms\n", percentile(charged_ms, 0.95));
+    std::printf("coverage: %.1f %%\n", 100.0 * coverage / n);
+    std::printf("done: %lld of %lld\n", static_cast<long long>(done), static_cast<long long>(runs));
+    std::printf("exploration_time: %.1f s\n", time_s / n);
+    if (reached_85 > 0) std::printf("time_to_85: %.1f s\n", time_85 / static_cast<double>(reached_85));
+    std::printf("distance: %.1f m\n", distance / n);
+    if (semantic_weight > 0)
+      std::printf("objects_observed: %.1f of %zu\n", static_cast<double>(objects_completed) / n,
+                  world->objects().size());
+    if (objects_done > 0)
+      std::printf("time_all_objects_observed: %.1f s\n", objects_time / static_cast<double>(objects_done));
+    std::printf("paths: %.1f\n", static_cast<double>(paths) / n);
+    std::printf("collisions: %lld\n", static_cast<long long>(collisions));
+    std::printf("wall_time: %.1f s\n", wall_s);
+    if (fit && counters.size() >= 6) {
+      // total_ms ≈ base + box·a + evals·b + steps·c + settled·d, least squares (no intercept drop).
+      Eigen::MatrixXd A(static_cast<Eigen::Index>(counters.size()), 5);
+      Eigen::VectorXd y(static_cast<Eigen::Index>(counters.size()));
+      for (size_t i = 0; i < counters.size(); ++i) {
+        const CycleCounters& k = counters[i];
+        const Eigen::Index r = static_cast<Eigen::Index>(i);
+        A(r, 0) = 1.0;
+        A(r, 1) = static_cast<double>(k.box_checks);
+        A(r, 2) = static_cast<double>(k.gain_evaluations);
+        A(r, 3) = static_cast<double>(k.ray_steps);
+        A(r, 4) = static_cast<double>(k.search_settled);
+        y(r) = k.cpu_ms * 1e-3;
+      }
+      // Non-negative least squares by elimination: a negative coefficient is fixed at 0 and the
+      // rest refitted (a cost cannot be negative).
+      std::vector<bool> active(5, true);
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(5);
+      for (int round = 0; round < 5; ++round) {
+        std::vector<int> cols;
+        for (int j = 0; j < 5; ++j)
+          if (active[static_cast<size_t>(j)]) cols.push_back(j);
+        Eigen::MatrixXd B(A.rows(), static_cast<Eigen::Index>(cols.size()));
+        for (size_t j = 0; j < cols.size(); ++j) B.col(static_cast<Eigen::Index>(j)) = A.col(cols[j]);
+        const Eigen::VectorXd z = B.colPivHouseholderQr().solve(y);
+        x.setZero();
+        int worst = -1;
+        for (size_t j = 0; j < cols.size(); ++j) {
+          x(cols[j]) = z(static_cast<Eigen::Index>(j));
+          if (z(static_cast<Eigen::Index>(j)) < 0 &&
+              (worst < 0 || z(static_cast<Eigen::Index>(j)) < x(worst)))
+            worst = cols[j];
+        }
+        if (worst < 0) break;
+        active[static_cast<size_t>(worst)] = false;
+      }
+      const Eigen::VectorXd res = A * x - y;
+      std::printf("fit_base_s: %.3e s\n", x(0));
+      std::printf("fit_per_box_check_s: %.3e s\n", x(1));
+      std::printf("fit_per_gain_node_s: %.3e s\n", x(2));
+      std::printf("fit_per_ray_step_s: %.3e s\n", x(3));
+      std::printf("fit_per_search_node_s: %.3e s\n", x(4));
+      std::printf("fit_rms_error: %.3f ms\n",
+                  1e3 * std::sqrt(res.squaredNorm() / static_cast<double>(res.size())));
+    }
+    return 0;
+  });
+}

@@ -1,0 +1,116 @@
+// The planner's configuration: the shipped YAML equals the defaults; overrides; strictness.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "semx/planner/planner_config.hpp"
+
+namespace semx::planner {
+namespace {
+
+using runtime::ConfigError;
+using runtime::load_config;
+
+TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
+  const PlannerConfig d;
+  const auto f = load_config<PlannerConfig>(std::string(SEMX_SOURCE_DIR) + "/planner/config/planner.yaml");
+#define SAME(field) EXPECT_EQ(f.field, d.field) << #field
+  SAME(planner);
+  SAME(seed);
+  SAME(rate_hz);
+  SAME(collision.vehicle_size);
+  SAME(collision.margin);
+  SAME(collision.clearance);
+  SAME(collision.edge_step);
+  SAME(collision.root_escape_radius);
+  SAME(sampling.samples);
+  SAME(sampling.max_attempts_factor);
+  SAME(sampling.max_draws_factor);
+  SAME(sampling.local_radius);
+  SAME(sampling.local_height);
+  SAME(sampling.frontier_fraction);
+  SAME(sampling.frontier_radius);
+  SAME(sampling.min_node_distance);
+  SAME(sampling.z_min);
+  SAME(sampling.z_max);
+  SAME(sampling.cluster_size);
+  SAME(sampling.min_cluster_voxels);
+  SAME(roadmap.k_nearest);
+  SAME(roadmap.max_edge_length);
+  SAME(gain.image_width);
+  SAME(gain.image_height);
+  SAME(gain.fx);
+  SAME(gain.fy);
+  SAME(gain.min_range);
+  SAME(gain.max_range);
+  SAME(gain.weight_unknown);
+  SAME(gain.weight_frontier);
+  SAME(gain.weight_surface);
+  SAME(gain.yaw_bins);
+  SAME(gain.rays_azimuth);
+  SAME(gain.rays_elevation);
+  SAME(gain.min_gain);
+  SAME(cost.velocity);
+  SAME(cost.yaw_rate);
+  SAME(cost.yaw_weight);
+  SAME(cost.min_time);
+  SAME(loop.goal_tolerance);
+  SAME(loop.yaw_tolerance);
+  SAME(loop.dwell_s);
+  SAME(loop.hysteresis);
+  SAME(loop.done_cycles);
+  SAME(loop.blacklist_cycles);
+  SAME(loop.visited_cycles);
+  SAME(loop.max_start_offset);
+  SAME(charge.base_s);
+  SAME(charge.per_box_check_s);
+  SAME(charge.per_gain_node_s);
+  SAME(charge.per_ray_step_s);
+  SAME(charge.per_search_node_s);
+  SAME(charge.scale);
+  SAME(nbv.step);
+  SAME(nbv.lambda);
+  SAME(nbv.radius);
+  SAME(aep.step);
+  SAME(aep.rewire_radius);
+  SAME(aep.lambda);
+  SAME(aep.radius);
+  SAME(aep.cache_radius);
+  SAME(aep.g_zero);
+#undef SAME
+}
+
+TEST(PlannerConfig, DefaultsMatchThePaperAndTheController) {
+  const PlannerConfig d;
+  EXPECT_EQ(d.sampling.samples, 45);
+  EXPECT_EQ(d.gain.weight_unknown, 1.0);
+  EXPECT_EQ(d.gain.weight_frontier, 2.0);
+  EXPECT_EQ(d.gain.weight_surface, 4.0);
+  EXPECT_EQ(d.gain.yaw_bins, 32);
+  EXPECT_NEAR(d.gain.horizontal_fov(), 3.14159265358979 / 2, 1e-12);
+  EXPECT_NEAR(d.gain.vertical_fov(), 2 * std::atan(0.75), 1e-12);
+  // Edges keep the controller's 0.4 m.
+  EXPECT_GE(d.collision.clearance - d.collision.edge_step / 2, 0.4 - 1e-12);
+  EXPECT_EQ(d.kind(), PlannerKind::kSemanticDep);
+}
+
+TEST(PlannerConfig, OverridesAndErrors) {
+  const auto c =
+      load_config<PlannerConfig>("", {"planner=aep", "sampling.samples=30", "gain.weight_surface=8"});
+  EXPECT_EQ(c.kind(), PlannerKind::kAep);
+  EXPECT_EQ(c.sampling.samples, 30);
+  EXPECT_EQ(c.gain.weight_surface, 8.0);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"planner=rrt"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.sample=30"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.samples=0"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"gain.rays_azimuth=100"}),
+               ConfigError);                                                          // not a multiple of 32
+  EXPECT_THROW(load_config<PlannerConfig>("", {"gain.max_range=0.2"}), ConfigError);  // below min_range
+  EXPECT_THROW(load_config<PlannerConfig>("", {"collision.vehicle_size=[1, 2]"}), ConfigError);
+  EXPECT_THROW(parse_planner_kind("DEP"), std::invalid_argument);
+  for (const char* name : {"semantic-dep", "dep", "nbv", "aep"})
+    EXPECT_STREQ(to_string(parse_planner_kind(name)), name);
+}
+
+}  // namespace
+}  // namespace semx::planner

@@ -1,0 +1,296 @@
+// The roadmap graph, the collision checks of nodes and edges, and DEP's incremental roadmap:
+// persistence across cycles, pruning of what new obstacles block, determinism.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "planner_test_util.hpp"
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/roadmap.hpp"
+
+namespace semx::planner {
+namespace {
+
+using mapper::VoxelState;
+
+TEST(Roadmap, NodesEdgesAndNeighbours) {
+  Roadmap g(1.0);
+  const int64_t a = g.add_node({0, 0, 0});
+  const int64_t b = g.add_node({1, 0, 0});
+  const int64_t c = g.add_node({0, 2, 0});
+  const int64_t d = g.add_node({5, 5, 5});
+  EXPECT_EQ(g.num_nodes(), 4u);
+  EXPECT_TRUE(g.add_edge(a, b, 1.0));
+  EXPECT_FALSE(g.add_edge(b, a, 1.0));  // already there
+  EXPECT_FALSE(g.add_edge(a, a, 0.0));
+  EXPECT_TRUE(g.add_edge(a, c, 2.0));
+  EXPECT_EQ(g.num_edges(), 2u);
+  EXPECT_TRUE(g.has_edge(b, a));
+  // Nearest first, within the radius, at most k.
+  EXPECT_EQ(g.nearest({0.1, 0, 0}, -1, 3.0), (std::vector<int64_t>{a, b, c}));
+  EXPECT_EQ(g.nearest({0.1, 0, 0}, 2, 3.0), (std::vector<int64_t>{a, b}));
+  EXPECT_EQ(g.nearest({0.1, 0, 0}, -1, 3.0, a), (std::vector<int64_t>{b, c}));
+  EXPECT_TRUE(g.any_within({4.9, 5, 5}, 0.2));
+  EXPECT_FALSE(g.any_within({4.9, 5, 5}, 0.2, d));
+  // Removing a node removes its edges; ids are never reused.
+  g.remove_node(a);
+  EXPECT_EQ(g.num_nodes(), 3u);
+  EXPECT_EQ(g.num_edges(), 0u);
+  EXPECT_FALSE(g.alive(a));
+  EXPECT_EQ(g.add_node({0, 0, 0}), 4);
+  g.move_node(d, {0.5, 0, 0});
+  EXPECT_EQ(g.nearest({0.4, 0, 0}, 1, 0.5), (std::vector<int64_t>{d}));
+}
+
+TEST(Roadmap, ShortestPaths) {
+  Roadmap g(1.0);
+  for (int i = 0; i < 5; ++i) g.add_node({static_cast<double>(i), 0, 0});
+  g.add_edge(0, 1, 1.0);
+  g.add_edge(1, 2, 1.0);
+  g.add_edge(0, 2, 2.5);  // longer than through 1
+  g.add_edge(2, 3, 1.0);
+  // node 4 unreachable
+  const Roadmap::Search s = g.shortest_paths(0);
+  EXPECT_DOUBLE_EQ(s.distance[2], 2.0);
+  EXPECT_DOUBLE_EQ(s.distance[3], 3.0);
+  EXPECT_FALSE(s.reached(4));
+  EXPECT_EQ(Roadmap::path_to(s, 3), (std::vector<int64_t>{0, 1, 2, 3}));
+  EXPECT_TRUE(Roadmap::path_to(s, 4).empty());
+  EXPECT_EQ(s.settled, 4);
+}
+
+// A 6 x 4 x 2.5 m room, known entirely (walls occupied).
+mapper::StateGrid known_room() { return SyntheticWorld::room({6, 4, 2.5}, {1, 2, 1.2}).full_map(); }
+
+TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
+  mapper::StateGrid g = known_room();
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  EXPECT_TRUE(c.node_free({3, 2, 1.2}));
+  EXPECT_TRUE(c.node_free({0.5, 2, 1.2}));   // 0.5 m from the wall x = 0
+  EXPECT_FALSE(c.node_free({0.4, 2, 1.2}));  // 0.4 m: below the 0.45 m clearance
+  EXPECT_FALSE(c.node_free({3, 2, 0.4}));    // the floor
+  EXPECT_FALSE(c.node_free({3, 2, 2.1}));    // the ceiling (2.5 m)
+  EXPECT_FALSE(c.node_free({-1, 2, 1.2}));   // outside
+  // Unknown space counts as occupied.
+  g.set_state(g.keys().key(Eigen::Vector3d(3.0, 2.4, 1.2)), VoxelState::kUnknown);
+  EXPECT_FALSE(c.node_free({3, 2, 1.2}));
+  EXPECT_TRUE(c.node_free({3, 1.4, 1.2}));
+  // Diagonal: a voxel 0.45 m away along each axis is 0.64 m away: the ball does not reach it but
+  // the body box (0.35 m) does not either.
+  mapper::StateGrid h = known_room();
+  c.set_grid(&h);
+  h.set_state(h.keys().key(Eigen::Vector3d(3.45, 2.45, 1.25)), VoxelState::kOccupied);
+  EXPECT_TRUE(c.node_free({3.0, 2.0, 1.2}));
+  EXPECT_FALSE(c.node_free({3.1, 2.1, 1.2}));
+}
+
+TEST(Collision, EdgesKeepTheClearanceAllAlong) {
+  mapper::StateGrid g = known_room();
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  EXPECT_TRUE(c.edge_free({1, 1, 1.2}, {5, 3, 1.2}));
+  // A thin pillar on the way, 1 voxel wide.
+  fill_m(g, {2.95, 1.95, 0}, {3.05, 2.05, 2.5}, VoxelState::kOccupied);
+  EXPECT_FALSE(c.edge_free({1, 2, 1.2}, {5, 2, 1.2}));
+  // Passing at 0.35 m from the pillar's face: blocked; at 0.55 m: free.
+  EXPECT_FALSE(c.edge_free({1, 2.4, 1.2}, {5, 2.4, 1.2}));
+  EXPECT_TRUE(c.edge_free({1, 2.6, 1.2}, {5, 2.6, 1.2}));
+  // A diagonal edge grazing the pillar's corner (2.9..3.1 x 1.9..2.1): every point of an edge
+  // that passes keeps clearance - edge_step/2 = 0.40 m from it.
+  for (double off = 0.2; off < 1.2; off += 0.05) {
+    const Eigen::Vector3d a(1.0, 2.0 + off - 1.0, 1.2), b(4.0, 2.0 + off + 0.5, 1.2);
+    if (!c.node_free(a) || !c.node_free(b) || !c.edge_free(a, b)) continue;
+    for (double t = 0; t <= 1.0; t += 0.002) {
+      const Eigen::Vector3d p = a + t * (b - a);
+      const double dx = std::max({2.9 - p.x(), 0.0, p.x() - 3.1}),
+                   dy = std::max({1.9 - p.y(), 0.0, p.y() - 2.1});
+      EXPECT_GE(std::hypot(dx, dy), 0.40 - 1e-9) << off << " " << t;
+    }
+  }
+  // Into unknown space: blocked.
+  mapper::StateGrid h = known_room();
+  fill_m(h, {4, 0, 0}, {6, 4, 2.5}, VoxelState::kUnknown);
+  c.set_grid(&h);
+  EXPECT_FALSE(c.edge_free({1, 2, 1.2}, {3.7, 2, 1.2}));  // its end 0.3 m from unknown space
+  EXPECT_TRUE(c.edge_free({1, 2, 1.2}, {3.5, 2, 1.2}));   // 0.5 m
+  EXPECT_TRUE(c.node_free({3.5, 2, 1.2}));
+}
+
+TEST(Collision, RootEdgesMayLeaveUnmappedSurroundings) {
+  mapper::StateGrid g = known_room();
+  // The vehicle at (1, 2, 1.2) never saw the voxels right above and below it.
+  fill_m(g, {0.6, 1.6, 0.5}, {1.4, 2.4, 0.9}, VoxelState::kUnknown);
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  const Eigen::Vector3d root(1, 2, 1.2), goal(3, 2, 1.2);
+  EXPECT_FALSE(c.node_free(root));
+  EXPECT_FALSE(c.edge_free(root, goal));
+  EXPECT_TRUE(c.root_edge_free(root, goal));
+  // But not through an obstacle.
+  fill_m(g, {1.6, 1.5, 0.8}, {1.8, 2.5, 1.6}, VoxelState::kOccupied);
+  EXPECT_FALSE(c.root_edge_free(root, goal));
+}
+
+// DEP's roadmap over cycles on a partly known map.
+struct DepFixture {
+  PlannerConfig config = test_config("dep");
+  mapper::StateGrid grid = mapper::StateGrid(0.1);
+  FrontierTracker frontiers{1.0};
+  Rng rng{7};
+  std::vector<SemanticRegion> regions;
+  CycleCounters counters;
+
+  PlanContext context(const Eigen::Vector3d& p, double yaw = 0.0, int64_t cycle = 1) {
+    PlanContext ctx;
+    ctx.grid = &grid;
+    ctx.pose.position = p;
+    ctx.pose.yaw = yaw;
+    ctx.regions = &regions;
+    ctx.frontiers = &frontiers;
+    ctx.cycle = cycle;
+    ctx.rng = &rng;
+    ctx.counters = &counters;
+    return ctx;
+  }
+};
+
+// The 10 x 4 m corridor, its first 6 m known (walls included), the rest unknown.
+void corridor(mapper::StateGrid& g) {
+  const SyntheticWorld w = SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2});
+  w.reveal(g, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.0, 4.2, 2.7)});
+}
+
+TEST(DepRoadmap, NodesAndEdgesAreCollisionFreeAndPersistAcrossCycles) {
+  DepFixture f;
+  corridor(f.grid);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({1, 2, 1.2});
+  const PlanOutcome first = dep.plan(ctx);
+  ASSERT_TRUE(first.goal.valid);
+  std::set<int64_t> ids;
+  CollisionChecker c(f.config.collision);
+  c.set_grid(&f.grid);
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (!n.alive) continue;
+    ids.insert(n.id);
+    if (n.id != dep.root()) {
+      EXPECT_TRUE(c.node_free(n.position)) << n.id;
+    }
+    for (const RoadmapEdge& e : n.edges) {
+      if (n.id == dep.root() || e.to == dep.root()) continue;
+      EXPECT_TRUE(c.edge_free(n.position, dep.graph().node(e.to).position));
+    }
+  }
+  EXPECT_GT(ids.size(), 20u);
+  // The next cycle keeps every node (nothing changed) and adds more.
+  PlanContext ctx2 = f.context({1.6, 2, 1.2}, 0.0, 2);
+  dep.plan(ctx2);
+  size_t kept = 0;
+  for (int64_t id : ids) kept += dep.graph().alive(id) ? 1 : 0;
+  EXPECT_GE(kept, ids.size() - 1);  // the old root may be merged away
+  EXPECT_GT(dep.graph().num_nodes(), ids.size());
+  // Gains were not recomputed for unchanged nodes: only the new ones and the root.
+  EXPECT_LE(f.counters.gain_evaluations, static_cast<int64_t>(dep.graph().num_nodes() + 2));
+}
+
+TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {
+  DepFixture f;
+  corridor(f.grid);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({1, 2, 1.2});
+  dep.plan(ctx);
+  // A wall across the corridor at x = 3.
+  std::vector<mapper::VoxelChange> changes;
+  const mapper::KeyMath& km = f.grid.keys();
+  for (double y = 0.05; y < 4; y += 0.1)
+    for (double z = 0.05; z < 2.5; z += 0.1) {
+      const mapper::VoxelKey k = km.key(Eigen::Vector3d(3.05, y, z));
+      f.grid.set_state(k, VoxelState::kOccupied);
+      changes.push_back({k, VoxelState::kOccupied});
+    }
+  dep.on_map_changes(changes);
+  PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
+  dep.process_map_changes(ctx2);
+  EXPECT_GT(f.counters.edges_pruned + f.counters.nodes_pruned, 0);
+  CollisionChecker c(f.config.collision);
+  c.set_grid(&f.grid);
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (!n.alive) continue;
+    if (n.id != dep.root()) {
+      EXPECT_TRUE(c.node_free(n.position));
+    }
+    for (const RoadmapEdge& e : n.edges) {
+      const Eigen::Vector3d& q = dep.graph().node(e.to).position;
+      // No edge crosses the wall.
+      EXPECT_FALSE((n.position.x() < 3.0) != (q.x() < 3.0)) << n.id << "-" << e.to;
+    }
+  }
+}
+
+TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
+  DepFixture f;
+  corridor(f.grid);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({1, 2, 1.2});
+  dep.plan(ctx);
+  // Evaluate everything, then change one voxel far beyond every node's range.
+  for (const RoadmapNode& n : dep.graph().slots())
+    if (n.alive && (n.gain_stale || !n.gain.valid)) dep.evaluate_gain(ctx, n.id);
+  const mapper::VoxelKey far = f.grid.keys().key(Eigen::Vector3d(30, 2, 1));
+  f.grid.set_state(far, VoxelState::kFree);
+  dep.on_map_changes({{far, VoxelState::kFree}});
+  PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
+  dep.process_map_changes(ctx2);
+  for (const RoadmapNode& n : dep.graph().slots())
+    if (n.alive) {
+      EXPECT_FALSE(n.gain_stale);
+    }
+  // A change next to them does.
+  const mapper::VoxelKey near = f.grid.keys().key(Eigen::Vector3d(6.5, 2, 1));
+  f.grid.set_state(near, VoxelState::kFree);
+  dep.on_map_changes({{near, VoxelState::kFree}});
+  dep.process_map_changes(ctx2);
+  int stale = 0;
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (!n.alive) continue;
+    if ((n.position - Eigen::Vector3d(6.5, 2, 1)).norm() < 4.0) {
+      EXPECT_TRUE(n.gain_stale);
+    }
+    stale += n.gain_stale;
+  }
+  EXPECT_GT(stale, 0);
+}
+
+TEST(DepRoadmap, SameSeedSameRoadmap) {
+  auto build = [](int64_t seed) {
+    DepFixture f;
+    f.rng.reseed(static_cast<uint64_t>(seed));
+    corridor(f.grid);
+    f.frontiers.reset(f.grid);
+    DepStrategy dep(f.config, false);
+    dep.on_map_reset();
+    PlanContext ctx = f.context({1, 2, 1.2});
+    dep.plan(ctx);
+    std::vector<Eigen::Vector3d> nodes;
+    for (const RoadmapNode& n : dep.graph().slots())
+      if (n.alive) nodes.push_back(n.position);
+    return nodes;
+  };
+  const auto a = build(3), b = build(3), c = build(4);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
+  EXPECT_FALSE(a.size() == c.size() && std::equal(a.begin(), a.end(), c.begin()));
+}
+
+}  // namespace
+}  // namespace semx::planner
