@@ -80,6 +80,7 @@ void load(runtime::ConfigMap& m, SemanticsConfig& c) {
   t.get("promote_probability", c.tracking.promote_probability, 0.0, 1.0);
   t.get("log_odds_hit", c.tracking.log_odds_hit, 0.0, 10.0);
   t.get("log_odds_miss", c.tracking.log_odds_miss, 0.0, 10.0);
+  t.get("region_log_odds_miss", c.tracking.region_log_odds_miss, 0.0, 10.0);
   t.get("log_odds_max", c.tracking.log_odds_max, 0.0, 100.0);
   t.get("drop_log_odds", c.tracking.drop_log_odds, -100.0, 0.0);
   t.get("tentative_timeout_s", c.tracking.tentative_timeout_s, 0.0, 3600.0);

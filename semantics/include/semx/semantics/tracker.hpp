@@ -80,9 +80,10 @@ class ObjectTracker {
   void clear();
 
   // Whether `track` should have been detected in `frame`: the surface voxels that shape its box
-  // (a sample of at most 512), projected into the image within the depth range and not hidden
-  // behind a nearer measurement, cover 8x8-pixel tiles worth at least 4 times the detector's
-  // minimum area (tiles overestimate a silhouette by up to a tile around its edge).
+  // (a sample of at most 512), projected into the image within the depth range (but not within
+  // 0.25 m of its end) and not hidden behind a nearer measurement, cover 4x4-pixel tiles worth
+  // at least 4 times the detector's minimum area (tiles overestimate a silhouette by up to a
+  // tile around its edge).
   bool in_view(const Track& track, const Frame& frame) const;
   // The association cost of a detection with a track, or a negative number outside the gate.
   double association_cost(const Track& track, const Detection3D& det) const;
@@ -99,7 +100,7 @@ class ObjectTracker {
   SemanticsConfig config_;
   std::vector<Track> tracks_;
   int64_t next_id_ = 1;
-  int64_t frames_ = 0;  // update() calls: stamps which frame last saw a surface voxel
+  int64_t frames_ = 0;                  // update() calls: stamps which frame last saw a surface voxel
   mutable std::vector<uint8_t> tiles_;  // in_view()'s scratch image of covered tiles
 };
 
