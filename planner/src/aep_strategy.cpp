@@ -16,7 +16,7 @@ AepStrategy::AepStrategy(const PlannerConfig& config)
       checker_(config.collision),
       gains_(config.gain),
       global_(config, false),
-      cache_(std::max(0.5, config.aep.cache_radius * 4)) {}
+      cache_(config.roadmap.max_edge_length) {}
 
 void AepStrategy::reset() {
   global_.reset();
@@ -120,8 +120,8 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     const Eigen::Vector3d from = tree_[static_cast<size_t>(near)].position;
     const double len = (q - from).norm();
     if (len < 1e-6) continue;
-    const Eigen::Vector3d p = from + std::min(len, a.step) / len * (q - from);
-    const bool node_ok = checker_.node_free(p);
+    Eigen::Vector3d p = from + std::min(len, a.step) / len * (q - from);
+    const bool node_ok = checker_.centre(p);  // moved off a wall when too close (as DEP's draws)
     ctx.counters->sample_ms += sw.ms();
     if (!node_ok) continue;
 
@@ -231,7 +231,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
       return gain * std::exp(-lambda * distance);
     };
     std::string reason;
-    out.goal = global_.select_goal(ctx, score, &reason);
+    out.goal = global_.select_goal(ctx, score, &reason, &out.unreachable_informative);
     if (!out.goal.valid) {
       std::ostringstream r;
       r << "local gain " << best_gain << " below g_zero " << a.g_zero << "; fallback: " << reason;

@@ -84,6 +84,38 @@ bool CollisionChecker::vehicle_free(const Eigen::Vector3d& p) const {
   return region_free(p, vehicle_half_, 0.0, false);
 }
 
+bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_step) const {
+  if (!grid_ || !p.allFinite()) return false;
+  const double res = grid_->resolution(), inv = 1.0 / res;
+  const double r = config_.clearance;
+  for (int it = 0; it < iterations; ++it) {
+    if (node_free(p)) return true;
+    ++box_checks_;
+    VoxelKey kmin, kmax;
+    for (int i = 0; i < 3; ++i) {
+      kmin[i] = static_cast<int32_t>(std::floor((p[i] - reach_[i]) * inv));
+      kmax[i] = static_cast<int32_t>(std::ceil((p[i] + reach_[i]) * inv)) - 1;
+    }
+    Eigen::Vector3d push = Eigen::Vector3d::Zero();
+    mapper::StateGrid::Reader reader = grid_->reader();
+    for (int32_t z = kmin.z; z <= kmax.z; ++z)
+      for (int32_t y = kmin.y; y <= kmax.y; ++y)
+        for (int32_t x = kmin.x; x <= kmax.x; ++x) {
+          if (reader.state({x, y, z}) == VoxelState::kFree) continue;
+          const Eigen::Vector3d lo(x * res, y * res, z * res);
+          const Eigen::Vector3d q = p.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
+          const Eigen::Vector3d v = p - q;
+          const double d = v.norm();
+          if (d >= r || d < 1e-9) continue;
+          push += (r - d) * v / d;
+        }
+    const double n = push.norm();
+    if (n < 1e-9) return false;  // inside an obstacle or pushed equally from all sides
+    p += push * std::min(1.0, max_step / n);
+  }
+  return node_free(p);
+}
+
 bool CollisionChecker::centre_line_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                         double skip_radius) const {
   if (!grid_) return false;
@@ -126,6 +158,8 @@ bool CollisionChecker::edge_free(const Eigen::Vector3d& a, const Eigen::Vector3d
 
 bool CollisionChecker::root_edge_free(const Eigen::Vector3d& root, const Eigen::Vector3d& b) const {
   if (!root.allFinite() || !b.allFinite()) return false;
+  // The escape rule only where it is needed: a root that has the clearance gets the full check.
+  if (node_free(root)) return edge_free(root, b);
   if (!centre_line_free(root, b, config_.root_escape_radius)) return false;
   return samples_free(root, b, config_.root_escape_radius);
 }

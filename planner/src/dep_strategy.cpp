@@ -173,9 +173,12 @@ int64_t DepStrategy::insert_root(PlanContext& ctx) {
   return root_;
 }
 
-int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& p) {
+int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   Stopwatch sample_watch;
-  const bool ok = checker_.node_free(p) && !graph_.any_within(p, config_.sampling.min_node_distance);
+  // A draw too close to a wall is moved away from it (centred in a doorway) rather than dropped.
+  Eigen::Vector3d p = draw;
+  const bool ok = checker_.centre(p) && ctx.grid->state(p) == VoxelState::kFree &&
+                  !graph_.any_within(p, config_.sampling.min_node_distance);
   ctx.counters->sample_ms += sample_watch.ms();
   if (!ok) return -1;
   Stopwatch connect_watch;
@@ -225,7 +228,8 @@ bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id) const {
          yaw_distance(ctx.pose.yaw, n.gain.yaw) < config_.loop.yaw_tolerance;
 }
 
-Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason) {
+Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
+                              int64_t* unreachable) {
   {
     Stopwatch w;
     search_ = graph_.shortest_paths(root_);
@@ -281,6 +285,13 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     goal.yaws = interpolate_yaws(goal.waypoints, ctx.pose.yaw, goal.yaw);
     break;
   }
+  int64_t cut_off = 0;
+  if (!goal.valid) {
+    for (const RoadmapNode& n : graph_.slots()) {
+      if (n.alive && !search_.reached(n.id) && n.gain.valid && n.gain.gain >= min_gain) ++cut_off;
+    }
+  }
+  if (unreachable) *unreachable = cut_off;
   if (!goal.valid && reason) {
     std::ostringstream s;
     const size_t clusters =
@@ -288,6 +299,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     s << "no reachable node with gain >= " << min_gain << " (" << reachable << " of " << graph_.num_nodes()
       << " nodes reachable); " << (ctx.frontiers ? ctx.frontiers->size() : 0) << " frontier voxels in "
       << clusters << " clusters left, none reachable";
+    if (cut_off > 0) s << "; " << cut_off << " informative nodes cut off from the vehicle";
     *reason = s.str();
   }
   return goal;
@@ -302,7 +314,9 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   // Sampling around the vehicle and the frontier clusters.
   std::vector<FrontierTracker::Cluster> clusters;
   if (ctx.frontiers) clusters = ctx.frontiers->clusters(config_.sampling.min_cluster_voxels);
-  const double fraction = ctx.recovering ? 1.0 : config_.sampling.frontier_fraction;
+  // Recovering: half the draws around the vehicle (to reconnect it to the roadmap), half around
+  // frontier clusters anywhere, and twice the attempts.
+  const double fraction = ctx.recovering ? 0.5 : config_.sampling.frontier_fraction;
   const int64_t checks = static_cast<int64_t>(config_.sampling.samples) *
                          config_.sampling.max_attempts_factor * (ctx.recovering ? 2 : 1);
   const int64_t draws = checks * config_.sampling.max_draws_factor;
@@ -320,7 +334,7 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   }
 
   PlanOutcome out;
-  out.goal = select_goal(ctx, paper_score(), &out.reason);
+  out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative);
   ctx.counters->box_checks += checker_.box_checks();
   checker_.reset_counters();
   return out;

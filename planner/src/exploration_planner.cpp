@@ -276,7 +276,10 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     }
     goal_ = Goal();  // nothing to fly
     ++no_goal_cycles_;
-    next = no_goal_cycles_ >= config_.loop.done_cycles ? PlannerState::kDone : PlannerState::kRecovering;
+    const int limit = o.unreachable_informative > 0
+                          ? std::max(config_.loop.done_cycles, config_.loop.max_recovery_cycles)
+                          : config_.loop.done_cycles;
+    next = no_goal_cycles_ >= limit ? PlannerState::kDone : PlannerState::kRecovering;
     reason = next == PlannerState::kDone ? o.reason : why + ": " + o.reason;
   } else {
     next = PlannerState::kExecuting;

@@ -95,8 +95,8 @@ PlanOutcome NbvStrategy::plan(PlanContext& ctx) {
     const Eigen::Vector3d d = q - from;
     const double len = d.norm();
     if (len < 1e-6) continue;
-    const Eigen::Vector3d p = from + std::min(len, config_.nbv.step) / len * d;
-    const bool node_ok = checker_.node_free(p);
+    Eigen::Vector3d p = from + std::min(len, config_.nbv.step) / len * d;
+    const bool node_ok = checker_.centre(p);  // moved off a wall when too close (as DEP's draws)
     ctx.counters->sample_ms += sw.ms();
     if (!node_ok) continue;
     Stopwatch cw;

@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
       ExplorationSimOptions o;
       o.max_time = max_time;
       o.semantic_weight = semantic_weight;
+      o.coverage_period = 1.0;
       ExplorationSim sim(*world, planner, o);
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
         if (verbose && out.status && out.status->iteration > 0) {
@@ -163,11 +164,11 @@ int main(int argc, char** argv) {
     }
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const double n = static_cast<double>(runs);
-    std::printf("world: %s\n", world->name().c_str());
-    std::printf("planner: %s\n", config.planner.c_str());
-    std::printf("samples: %d\n", config.sampling.samples);
-    std::printf("runs: %lld\n", static_cast<long long>(runs));
-    std::printf("cycles: %zu\n", cycle_ms.size());
+    std::fprintf(stderr, "semx-perf-planner: world %s, planner %s\n", world->name().c_str(),
+                 config.planner.c_str());
+    std::printf("samples: %d candidates\n", config.sampling.samples);
+    std::printf("runs: %lld explorations\n", static_cast<long long>(runs));
+    std::printf("cycles: %zu cycles\n", cycle_ms.size());
     std::printf("cycle_cpu_p50: %.2f ms\n", percentile(cycle_cpu_ms, 0.5));
     std::printf("cycle_cpu_p95: %.2f ms\n", percentile(cycle_cpu_ms, 0.95));
     std::printf("cycle_cpu_max: %.2f ms\n", percentile(cycle_cpu_ms, 1.0));
@@ -179,24 +180,25 @@ int main(int argc, char** argv) {
     std::printf("connect_mean: %.2f ms\n", mean(connect_ms));
     std::printf("gain_mean: %.2f ms\n", mean(gain_ms));
     std::printf("search_mean: %.2f ms\n", mean(search_ms));
-    std::printf("gain_evaluations_mean: %.1f per cycle\n", mean(evals));
+    std::printf("gain_evaluations_mean: %.1f evaluations\n", mean(evals));
     std::printf("charged_mean: %.2f ms\n", mean(charged_ms));
     std::printf("charged_p95: %.2f ms\n", percentile(charged_ms, 0.95));
     std::printf("coverage: %.1f %%\n", 100.0 * coverage / n);
-    std::printf("done: %lld of %lld\n", static_cast<long long>(done), static_cast<long long>(runs));
+    std::printf("done: %lld explorations\n", static_cast<long long>(done));
     std::printf("exploration_time: %.1f s\n", time_s / n);
     if (reached_85 > 0) std::printf("time_to_85: %.1f s\n", time_85 / static_cast<double>(reached_85));
     std::printf("distance: %.1f m\n", distance / n);
-    if (semantic_weight > 0)
-      std::printf("objects_observed: %.1f of %zu\n", static_cast<double>(objects_completed) / n,
-                  world->objects().size());
+    if (semantic_weight > 0) {
+      std::printf("objects_total: %zu objects\n", world->objects().size());
+      std::printf("objects_observed: %.1f objects\n", static_cast<double>(objects_completed) / n);
+    }
     if (objects_done > 0)
       std::printf("time_all_objects_observed: %.1f s\n", objects_time / static_cast<double>(objects_done));
-    std::printf("paths: %.1f\n", static_cast<double>(paths) / n);
-    std::printf("collisions: %lld\n", static_cast<long long>(collisions));
+    std::printf("paths: %.1f paths\n", static_cast<double>(paths) / n);
+    std::printf("collisions: %lld steps\n", static_cast<long long>(collisions));
     std::printf("wall_time: %.1f s\n", wall_s);
     if (fit && counters.size() >= 6) {
-      // total_ms ≈ base + box·a + evals·b + steps·c + settled·d, least squares (no intercept drop).
+      // cpu_ms ≈ base + box·a + evals·b + steps·c + settled·d.
       Eigen::MatrixXd A(static_cast<Eigen::Index>(counters.size()), 5);
       Eigen::VectorXd y(static_cast<Eigen::Index>(counters.size()));
       for (size_t i = 0; i < counters.size(); ++i) {

@@ -59,6 +59,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(loop.dwell_s);
   SAME(loop.hysteresis);
   SAME(loop.done_cycles);
+  SAME(loop.max_recovery_cycles);
   SAME(loop.blacklist_cycles);
   SAME(loop.visited_cycles);
   SAME(loop.max_start_offset);

@@ -311,7 +311,8 @@ TEST_P(Baselines, ProduceValidPathsAndExploreWithoutCollisions) {
   if (kind == PlannerKind::kNbv) {
     // Receding horizon: one edge of at most the RRT step.
     EXPECT_LE(audit.max_waypoints, 2u);
-    EXPECT_LE(audit.longest_first_step, p.config().nbv.step + 1e-9);
+    // (plus at most 3 × 0.3 m when the steered point was moved off a wall: CollisionChecker::centre)
+    EXPECT_LE(audit.longest_first_step, p.config().nbv.step + 0.9 + 1e-9);
   }
 }
 

@@ -9,11 +9,12 @@
 //   edge_free(a, b): the same test at points of the segment at most edge_step apart (a and b are
 //                    nodes, checked already). Every point of the segment is within edge_step/2
 //                    of a checked point, so it keeps clearance - edge_step/2 (0.40 m);
-//   root_edge_free(root, b): as edge_free, except that points within root_escape_radius of the
-//                    root are checked with the bare vehicle box against occupied voxels only: the
-//                    vehicle may leave a pose whose surroundings are not mapped yet (the camera
-//                    never sees the cone above and below itself: 0.6 m deep for a ±37° vertical
-//                    field of view and a 0.45 m clearance) or that drifted close to a wall.
+//   root_edge_free(root, b): edge_free when the root itself is node_free; otherwise points within
+//                    root_escape_radius of the root are checked with the bare vehicle box against
+//                    occupied voxels only: the vehicle may leave a pose whose surroundings are not
+//                    mapped yet (the camera never sees the cone above and below itself: 0.6 m deep
+//                    for a ±37° vertical field of view and a 0.45 m clearance) or that drifted
+//                    close to a wall.
 //
 // The centre line is first walked voxel by voxel (no occupied or unknown voxel on it), which
 // rejects edges through walls and into unknown space for the price of one ray.
@@ -41,6 +42,11 @@ class CollisionChecker {
   bool root_edge_free(const Eigen::Vector3d& root, const Eigen::Vector3d& b) const;
   // The bare vehicle box at p overlaps no occupied voxel (unknown allowed).
   bool vehicle_free(const Eigen::Vector3d& p) const;
+  // Moves p away from the occupied and unknown voxels within `clearance` of it (each pushes by
+  // how much it intrudes, along the line from its cube's nearest point), up to `iterations` times
+  // and by at most max_step each; true when p ends node_free. Centres a draw that fell too close
+  // to a wall, and in a doorway between both jambs, so narrow passages get nodes and edges.
+  bool centre(Eigen::Vector3d& p, int iterations = 3, double max_step = 0.3) const;
 
   // Box checks made so far (for the planning-time charge); reset by the caller.
   int64_t box_checks() const { return box_checks_; }

@@ -57,7 +57,9 @@ class DepStrategy : public Strategy {
   int64_t try_insert(PlanContext& ctx, const Eigen::Vector3d& p);
   // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
   using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
-  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason);
+  // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach.
+  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
+                   int64_t* unreachable = nullptr);
   // The paper's score (G + R_sem) / T_path (travel_cost.hpp).
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);

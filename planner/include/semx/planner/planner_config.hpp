@@ -79,7 +79,7 @@ struct GainConfig {
   int yaw_bins = 32;        // azimuth histogram (DEP)
   int rays_azimuth = 128;   // gain rays around the node (a multiple of yaw_bins)
   int rays_elevation = 10;  // rays across the vertical field of view
-  double min_gain = 20.0;   // a node with G below this is not a goal (weighted voxels)
+  double min_gain = 50.0;   // a node with G below this is not a goal (weighted voxels)
 
   double horizontal_fov() const;  // rad
   double vertical_fov() const;    // rad
@@ -99,7 +99,10 @@ struct LoopConfig {
   double dwell_s = 0.3;         // s within tolerance before the goal counts as reached
   double hysteresis = 1.5;      // switch goals only for a score this many times better
   int done_cycles = 5;          // consecutive cycles without any goal before DONE
-  int blacklist_cycles = 20;    // a goal the controller rejected is skipped this long
+  // ... or this many when informative roadmap nodes exist that the vehicle cannot reach (the
+  // recovery sampling may reconnect them).
+  int max_recovery_cycles = 40;
+  int blacklist_cycles = 20;  // a goal the controller rejected is skipped this long
   // A goal just reached is skipped this long: what its gain still counts after the vehicle stood
   // there and looked is what the camera could not see (sensor-model mismatch), not a reason to
   // come back at once.
@@ -131,7 +134,7 @@ struct AepConfig {
   double lambda = 0.5;         // 1/m
   double radius = 5.0;         // m, local sampling box half width
   double cache_radius = 0.3;   // m, a cached gain this close to a tree node is reused
-  double g_zero = 40.0;        // local gain below this triggers the frontier fallback
+  double g_zero = 100.0;       // local gain below this triggers the frontier fallback
 };
 
 struct PlannerConfig {

@@ -48,6 +48,9 @@ struct Goal {
 struct PlanOutcome {
   Goal goal;           // invalid when nothing worth flying to was found
   std::string reason;  // why there is no goal (becomes the DONE reason)
+  // No goal, but roadmap nodes with gain exist that the vehicle cannot reach (the graph came
+  // apart, e.g. edges through a doorway were pruned): worth recovering longer before DONE.
+  int64_t unreachable_informative = 0;
 };
 
 class Strategy {
