@@ -157,6 +157,31 @@ TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
   for (pid_t pid : started_pids(text)) EXPECT_FALSE(pid_alive(pid));
 }
 
+TEST(Processes, HiddenOutputGoesToTheLogAndShowsWhenItFails) {
+  const std::string dir = temp_path("launch-logs");
+  const std::string set = temp_path("hidden.yaml");
+  std::ofstream(set) << "name: hidden\nlog_dir: " << dir
+                     << "\nprocesses:\n"
+                        "  - name: chatty\n    command: [/bin/sh, -c, \"echo secret-line; sleep 0.3; exit 4\"]\n"
+                        "    show: false\n"
+                        "  - name: quiet\n    command: [/bin/sh, -c, \"printf 'hidden%s' -ok\"]\n    show: false\n"
+                        "    required: false\n"
+                        "  - name: shown\n    command: [/bin/sh, -c, \"echo visible-line; sleep 5\"]\n";
+  const std::string out = temp_path("hidden.out");
+  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  EXPECT_EQ(launcher.wait(20), 1);
+  const std::string text = read_file(out);
+  EXPECT_NE(text.find("shown  | visible-line"), std::string::npos) << text;
+  // A hidden process that exits 0 stays hidden; one that fails shows what it said last.
+  EXPECT_EQ(text.find("hidden-ok"), std::string::npos) << text;
+  EXPECT_NE(text.find("chatty: its last lines:"), std::string::npos) << text;
+  EXPECT_NE(text.find("chatty | secret-line"), std::string::npos) << text;
+  // Every line is in the process's log, shown or not.
+  EXPECT_NE(read_file(dir + "/chatty.log").find("secret-line"), std::string::npos);
+  EXPECT_NE(read_file(dir + "/quiet.log").find("hidden-ok"), std::string::npos);
+  EXPECT_NE(read_file(dir + "/shown.log").find("visible-line"), std::string::npos);
+}
+
 TEST(Processes, MissingProgramAndBadSetAreClearErrors) {
   const std::string set = temp_path("missing.yaml");
   std::ofstream(set) << "name: m\nprocesses:\n  - name: ghost\n    command: [semx-does-not-exist]\n";

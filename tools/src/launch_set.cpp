@@ -64,6 +64,13 @@ LaunchSet load_launch_set(const std::string& file, const std::map<std::string, s
   std::map<std::string, std::string> vars = builtins;
   for (const auto& [k, v] : set.args) vars[k] = v;
 
+  root.get("log_dir", set.log_dir);
+  try {
+    set.log_dir = substitute(set.log_dir, vars);
+  } catch (const std::exception& e) {
+    root.fail("log_dir", e.what());
+  }
+
   for (ConfigMap& p : root.children("processes")) {
     ProcessSpec spec;
     p.get("name", spec.name);
@@ -94,6 +101,7 @@ LaunchSet load_launch_set(const std::string& file, const std::map<std::string, s
     p.get("required", spec.required);
     p.get("ends_set", spec.ends_set);
     p.get("start_delay", spec.start_delay_s, 0.0, 600.0);
+    p.get("show", spec.show);
     ConfigMap env = p.child("env");
     if (env.node().IsMap()) {
       for (const auto& kv : env.node()) {

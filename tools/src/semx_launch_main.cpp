@@ -33,7 +33,7 @@ std::string source_root() {
 
 int main(int argc, char** argv) {
   return run_main("semx-launch", [&] {
-    std::string set_name, lcm_url;
+    std::string set_name, lcm_url, log_dir;
     std::vector<std::string> arg_list;
     double duration = 0, grace = 5;
     bool list = false, no_color = false;
@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
         .option("lcm-url", "URL", "LCM provider for every process (exported as LCM_DEFAULT_URL)", &lcm_url)
         .option("duration", "S", "stop the set after S wall seconds", &duration)
         .option("grace", "S", "seconds between SIGINT and SIGKILL when stopping (default 5)", &grace)
+        .option("log-dir", "DIR", "write each process's output to DIR/NAME.log too (overrides the set's log_dir)",
+                &log_dir)
         .flag("list", "print the set's args and processes and exit", &list)
         .flag("no-color", "do not colour process names", &no_color);
     if (!p.parse(argc, argv)) return 0;
@@ -74,6 +76,7 @@ int main(int argc, char** argv) {
     o.lcm_url = lcm_url;
     o.duration_s = duration;
     o.grace_s = grace;
+    o.log_dir = log_dir;
     o.color = !no_color && isatty(STDOUT_FILENO);
     const LaunchSet set = load_launch_set(file, overrides, {{"root", root}, {"bin", o.bin_dir}});
     if (list) {

@@ -11,7 +11,11 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <deque>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <memory>
 #include <vector>
 
 namespace semx::tools {
@@ -41,7 +45,11 @@ struct Child {
   bool pending = true;
   bool finished = false;
   const char* color = "";
+  std::unique_ptr<std::ofstream> log;  // log_dir/NAME.log, when the set has a log_dir
+  std::deque<std::string> recent;      // last lines of a hidden process, shown if it fails
 };
+
+constexpr std::size_t kRecentLines = 15;
 
 const char* kColors[] = {"\033[36m", "\033[32m", "\033[33m", "\033[35m", "\033[34m", "\033[91m", "\033[92m"};
 
@@ -63,12 +71,23 @@ class Supervisor {
     width_ = width;
     int k = 0;
     const double t0 = now_s();
+    const std::string log_dir = o.log_dir.empty() ? set.log_dir : o.log_dir;
+    if (!log_dir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(log_dir, ec);
+      if (ec) throw std::runtime_error("log directory '" + log_dir + "': " + ec.message());
+    }
     for (const auto& p : set.processes) {
       Child c;
       c.spec = &p;
       c.start_at = t0 + p.start_delay_s;
       c.color = o.color ? kColors[k++ % 7] : "";
-      children_.push_back(c);
+      if (!log_dir.empty()) {
+        const std::string file = log_dir + "/" + p.name + ".log";
+        c.log = std::make_unique<std::ofstream>(file, std::ios::app);
+        if (!*c.log) throw std::runtime_error("cannot write process log '" + file + "'");
+      }
+      children_.push_back(std::move(c));
     }
   }
 
@@ -115,7 +134,17 @@ class Supervisor {
   void say(const std::string& msg) { std::cout << "[semx-launch] " << msg << std::endl; }
   void say(const Child& c, const std::string& msg) { say(c.spec->name + ": " + msg); }
 
-  void emit_line(const Child& c, const std::string& line) {
+  void emit_line(Child& c, const std::string& line) {
+    if (c.log) *c.log << line << "\n";
+    if (!c.spec->show) {
+      c.recent.push_back(line);
+      if (c.recent.size() > kRecentLines) c.recent.pop_front();
+      return;
+    }
+    print_line(c, line);
+  }
+
+  void print_line(const Child& c, const std::string& line) {
     std::string name = c.spec->name;
     name.resize(width_, ' ');
     std::cout << c.color << name << (o_.color ? "\033[0m" : "") << " | " << line << "\n";
@@ -131,7 +160,16 @@ class Supervisor {
       emit_line(c, c.partial);
       c.partial.clear();
     }
+    if (c.log) c.log->flush();
     std::cout.flush();
+  }
+
+  // A hidden process that failed: what it said last, so nobody has to look for the log.
+  void show_recent(Child& c) {
+    if (c.spec->show || c.recent.empty()) return;
+    say(c, "its last lines:");
+    for (const auto& line : c.recent) print_line(c, line);
+    c.recent.clear();
   }
 
   void drain(Child& c) {
@@ -259,6 +297,7 @@ class Supervisor {
                                     ? "exited with " + std::to_string(code)
                                     : std::string("killed by signal ") + strsignal(WTERMSIG(status));
         const ExitAction action = on_process_exit(*c.spec, code, c.restarts, stopping_);
+        if (code != 0 && !stopping_) show_recent(c);
         switch (action) {
           case ExitAction::kRestart:
             ++c.restarts;

@@ -2,6 +2,8 @@
 
 #include <semx/odometry_t.hpp>
 #include <semx/planner_status_t.hpp>
+#include <semx/roadmap_t.hpp>
+#include <semx/semantic_regions_t.hpp>
 #include <semx/sim_event_t.hpp>
 
 #include <chrono>
@@ -10,6 +12,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <unordered_map>
 
 #include "semx/evaluator/map_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
@@ -90,6 +93,32 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
                   m.reason.empty() ? "" : ": ", m.reason.c_str());
       std::fflush(stdout);
     }
+  });
+  // Only kept for the run folder's picture: the last of each, nothing is computed from them.
+  node_.subscribe<semx::roadmap_t>(ch::ROADMAP, [this](const semx::roadmap_t& m) {
+    RoadmapOverlay r;
+    std::unordered_map<int64_t, Eigen::Vector2d> at;
+    for (const auto& n : m.nodes) {
+      if (!finite3(n.position)) continue;
+      const Eigen::Vector2d p(n.position[0], n.position[1]);
+      at.emplace(n.id, p);
+      r.nodes.push_back(p);
+      r.frontier.push_back((n.flags & semx::roadmap_node_t::FRONTIER) != 0);
+    }
+    const size_t edges = std::min(m.edge_from.size(), m.edge_to.size());
+    for (size_t i = 0; i < edges; ++i) {
+      const auto a = at.find(m.edge_from[i]), b = at.find(m.edge_to[i]);
+      if (a != at.end() && b != at.end()) r.edges.emplace_back(a->second, b->second);
+    }
+    roadmap_ = std::move(r);
+  });
+  node_.subscribe<semx::semantic_regions_t>(ch::SEMANTIC_REGIONS, [this](const semx::semantic_regions_t& m) {
+    std::vector<RegionOverlay> regions;
+    for (const auto& g : m.regions) {
+      if (!finite3(g.centroid) || !std::isfinite(g.radius) || g.radius < 0 || g.radius > 100) continue;
+      regions.push_back({Eigen::Vector2d(g.centroid[0], g.centroid[1]), g.radius, g.label, g.active != 0});
+    }
+    regions_ = std::move(regions);
   });
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
   node_.set_state(runtime::NodeState::kRunning, "waiting for the simulation");
@@ -176,9 +205,17 @@ void EvaluatorNode::write_folder() {
                               std::to_string(static_cast<int>(std::floor(s.coverage_pct))) +
                               " %, t=" + std::to_string(static_cast<int>(std::lround(s.time_f_s))) + " s";
     const std::string png = (std::filesystem::path(options_.out_dir) / "map.png").string();
-    run_map_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.trajectory, title)
+    // The roadmap and the regions beneath the trajectory, so the flight stays readable.
+    run_map_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.trajectory, title,
+                    [this](MapPicture& p) {
+                      add_roadmap(p, roadmap_);
+                      add_regions(p, regions_);
+                    })
         .write_png(png);
     written_.push_back(png);
+    const std::string bt = (std::filesystem::path(options_.out_dir) / "map.bt").string();
+    write_octomap_bt(grid, bt);
+    written_.push_back(bt);
   } catch (const std::exception& e) {
     write_failed_ = true;
     std::cerr << "semx-evaluator: " << e.what() << "\n";

@@ -17,6 +17,7 @@
 
 #include "map_client.hpp"
 #include "semx/evaluator/evaluation.hpp"
+#include "semx/evaluator/run_overlays.hpp"
 #include "semx/runtime/node.hpp"
 
 namespace semx::evaluator {
@@ -69,6 +70,8 @@ class EvaluatorNode {
   double next_progress_s_ = 0;
   std::vector<std::string> written_;
   bool write_failed_ = false;
+  RoadmapOverlay roadmap_;               // the planner's last ROADMAP
+  std::vector<RegionOverlay> regions_;  // the last SEMANTIC_REGIONS
 };
 
 }  // namespace semx::evaluator

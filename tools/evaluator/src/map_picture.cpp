@@ -12,15 +12,17 @@ namespace semx::evaluator {
 
 namespace {
 constexpr double kEps = 1e-9;
-constexpr int kLegendWidth = 180;
+constexpr int kLegendWidth = 250;  // the longest entry: "semantic regions, observed (NN in all)"
 }  // namespace
 
 MapView MapView::of_world(const simulator::World& world) {
   MapView v;
   v.lo = world.bounds.min.head<2>();
   v.hi = world.bounds.max.head<2>();
-  v.z_lo = world.bounds.min.z() + 0.15;
-  v.z_hi = std::max(v.z_lo, world.bounds.max.z() - 0.3);
+  // Clear of the voxels the floor's and ceiling's surfaces fall into (a hit at z = 0 lands in
+  // the voxel above it as often as below), which would otherwise darken every column.
+  v.z_lo = world.bounds.min.z() + 0.3;
+  v.z_hi = std::max(v.z_lo, world.bounds.max.z() - 0.4);
   return v;
 }
 
@@ -35,7 +37,8 @@ MapPicture::MapPicture(const mapper::StateGrid& grid, const MapView& view, MapPi
   kz1_ = std::max(kz0_, static_cast<int32_t>(std::floor(view_.z_hi * inv)));
   nx_ = std::clamp(kx1 - kx0_ + 1, 1, 20000);
   ny_ = std::clamp(ky1 - ky0_ + 1, 1, 20000);
-  ppc_ = std::max(1, options_.max_side_px / std::max(nx_, ny_));
+  ppc_ = options_.pixels_per_column > 0 ? options_.pixels_per_column
+                                        : std::max(1, options_.max_side_px / std::max(nx_, ny_));
   cells_.assign(static_cast<size_t>(nx_) * ny_, Column::kUnknown);
   auto reader = grid.reader();
   for (int iy = 0; iy < ny_; ++iy) {
@@ -101,11 +104,19 @@ void MapPicture::add_text(const Eigen::Vector2d& p, const std::string& text, Rgb
   overlays_.push_back({Overlay::kText, {p}, 0, color, text, false, 1});
 }
 
+void MapPicture::add_arrow(const Eigen::Vector2d& from, const Eigen::Vector2d& to, Rgb color,
+                           int thickness_px) {
+  overlays_.push_back({Overlay::kArrow, {from, to}, 0, color, "", false, thickness_px});
+}
+
 void MapPicture::add_legend(const std::string& text, Rgb color) { legend_.emplace_back(text, color); }
 
 Eigen::Vector2i MapPicture::pixel(const Eigen::Vector2d& p) const {
-  const double fx = (p.x() / res_ - kx0_) * ppc_;
-  const double fy = (ny_ - (p.y() / res_ - ky0_)) * ppc_;
+  // Clamped so that lround stays within int; OpenCV clips what lies outside the image.
+  constexpr double kFar = 1e6;
+  const double fx = std::clamp((p.x() / res_ - kx0_) * ppc_, -kFar, kFar);
+  const double fy = std::clamp((ny_ - (p.y() / res_ - ky0_)) * ppc_, -kFar, kFar);
+  if (!std::isfinite(fx) || !std::isfinite(fy)) return {-static_cast<int>(kFar), -static_cast<int>(kFar)};
   return {options_.margin_px + static_cast<int>(std::lround(fx)),
           options_.margin_px + static_cast<int>(std::lround(fy))};
 }
@@ -135,6 +146,7 @@ Image MapPicture::render() const {
   // Overlays, in order.
   for (const Overlay& o : overlays_) {
     const cv::Scalar c = draw::bgr(o.color);
+    if (o.kind != Overlay::kPolyline && !(o.points.front().allFinite() && std::isfinite(o.radius))) continue;
     switch (o.kind) {
       case Overlay::kPolyline: {
         std::vector<cv::Point> pts;
@@ -147,11 +159,17 @@ Image MapPicture::render() const {
       }
       case Overlay::kCircle: {
         const cv::Point p = pt(o.points[0]);
-        const int r = std::max(1, static_cast<int>(std::lround(o.radius / res_ * ppc_)));
+        const int r = static_cast<int>(std::lround(std::clamp(o.radius / res_ * ppc_, 1.0, 1e5)));
         if (o.filled) {
-          cv::Mat layer = img.clone();
-          cv::circle(layer, p, r, c, cv::FILLED, cv::LINE_AA);
-          cv::addWeighted(layer, 0.25, img, 0.75, 0, img);
+          // Blend only the circle's box: the same pixels as blending the whole image, at a
+          // cost that does not grow with the picture (the viewer draws many regions a frame).
+          const cv::Rect box = cv::Rect(p.x - r - 2, p.y - r - 2, 2 * r + 5, 2 * r + 5) & cv::Rect(0, 0, W, H);
+          if (box.area() > 0) {
+            cv::Mat roi = img(box);
+            cv::Mat layer = roi.clone();
+            cv::circle(layer, p - box.tl(), r, c, cv::FILLED, cv::LINE_AA);
+            cv::addWeighted(layer, 0.25, roi, 0.75, 0, roi);
+          }
         }
         cv::circle(img, p, r, c, std::max(1, o.thickness), cv::LINE_AA);
         draw::text_left(img, o.text,
@@ -170,6 +188,15 @@ Image MapPicture::render() const {
       case Overlay::kText:
         draw::text_left(img, o.text, pt(o.points[0]), 0.45, c);
         break;
+      case Overlay::kArrow: {
+        if (!o.points[1].allFinite()) break;
+        const cv::Point a = pt(o.points[0]), b = pt(o.points[1]);
+        const double len = std::hypot(b.x - a.x, b.y - a.y);
+        if (len < 1) break;
+        // A head of about 10 px whatever the arrow's length.
+        cv::arrowedLine(img, a, b, c, std::max(1, o.thickness), cv::LINE_AA, 0, std::min(0.6, 10.0 / len));
+        break;
+      }
     }
   }
   // Title, scale bar, legend.
@@ -200,11 +227,12 @@ void MapPicture::write_png(const std::string& path) const { evaluator::write_png
 
 MapPicture run_map_picture(const mapper::StateGrid& grid, const simulator::World& world,
                            const simulator::GroundTruth* gt, const std::vector<Eigen::Vector3d>& trajectory,
-                           const std::string& title) {
+                           const std::string& title, const std::function<void(MapPicture&)>& beneath) {
   MapPictureOptions o;
   o.title = title;
   MapPicture pic(grid, MapView::of_world(world), o);
   if (gt) pic.underlay_ground_truth(*gt);
+  if (beneath) beneath(pic);
   const Rgb path{30, 90, 220}, start{40, 170, 60}, end{220, 50, 40};
   pic.add_legend("trajectory", path);
   if (!trajectory.empty()) {

@@ -19,6 +19,9 @@ struct ProcessSpec {
   bool required = true;      // its failure (after restarts) fails the whole set
   bool ends_set = false;     // its successful exit ends the whole set (e.g. the clock after N ticks)
   double start_delay_s = 0;  // wall seconds after the set starts
+  // false: its lines go to the set's log only (the console shows the last of them if it fails),
+  // so a set can show one progress line per process that matters.
+  bool show = true;
   std::map<std::string, std::string> env;
 };
 
@@ -27,6 +30,7 @@ struct LaunchSet {
   std::string description;
   std::string file;
   std::map<std::string, std::string> args;  // after overrides
+  std::string log_dir;  // every process's output also goes to log_dir/NAME.log (empty: none)
   std::vector<ProcessSpec> processes;
 };
 

@@ -18,6 +18,7 @@ struct SupervisorOptions {
   double duration_s = 0;  // stop the set after this many wall seconds (0: never)
   double grace_s = 5.0;   // SIGINT -> SIGKILL
   bool color = false;
+  std::string log_dir;    // overrides the set's log_dir
 };
 
 // Returns the exit code of the set: 0 ended normally (or --duration), 1 a required process

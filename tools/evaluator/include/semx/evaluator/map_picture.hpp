@@ -2,7 +2,8 @@
 // drawn occupied (any occupied voxel), else free (any free voxel), else unknown; optionally the
 // ground truth's walls where the map knows nothing; then overlays in world coordinates:
 // polylines (the flown trajectory, a path, roadmap edges), circles with labels (semantic
-// regions, roadmap nodes), markers and text. A scale bar, a legend and a title frame it.
+// regions, roadmap nodes), markers, arrows (a heading) and text. A scale bar, a legend and a
+// title frame it.
 //
 //   MapPicture pic(mirror.grid(), MapView::of_world(world));
 //   pic.underlay_ground_truth(gt);
@@ -16,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,13 +35,16 @@ struct MapView {
   double z_lo = 0.1;
   double z_hi = 2.5;
 
-  // The world's bounds; heights from 0.15 m above the bounds' floor to 0.3 m below their top,
-  // which leaves out the floor and ceiling slabs of the shipped worlds.
+  // The world's bounds; heights from 0.3 m above the bounds' floor to 0.4 m below their top,
+  // which leaves out the floor and ceiling slabs of the shipped worlds and their surface voxels.
   static MapView of_world(const simulator::World& world);
 };
 
 struct MapPictureOptions {
   int max_side_px = 1000;  // pixels per voxel chosen so the longer side is at most this (>= 1 px)
+  // > 0: exactly this many pixels per voxel column, whatever max_side_px says (a fixed scale,
+  // e.g. the viewer's --scale, so frames of one run line up).
+  int pixels_per_column = 0;
   int margin_px = 36;      // room for the title, scale bar and legend
   std::string title;
   bool legend = true;
@@ -70,6 +75,8 @@ class MapPicture {
   // A dot of fixed pixel size (start, end, nodes), with an optional label.
   void add_marker(const Eigen::Vector2d& p, Rgb color, const std::string& label = "", int radius_px = 5);
   void add_text(const Eigen::Vector2d& p, const std::string& text, Rgb color);
+  // An arrow from `from` to `to` (a heading: the vehicle's pose in the viewer).
+  void add_arrow(const Eigen::Vector2d& from, const Eigen::Vector2d& to, Rgb color, int thickness_px = 2);
   // An extra legend entry (colour swatch and text).
   void add_legend(const std::string& text, Rgb color);
 
@@ -79,6 +86,7 @@ class MapPicture {
   int pixels_per_column() const { return ppc_; }
   Column column(int ix, int iy) const { return cells_[static_cast<size_t>(iy) * nx_ + ix]; }
   // Pixel of a world point in the rendered image (y up in the world is up in the picture).
+  // Points far outside the view (or not finite) map to a far-away pixel, never to an overflow.
   Eigen::Vector2i pixel(const Eigen::Vector2d& p) const;
   int64_t count(Column c) const;
 
@@ -87,7 +95,7 @@ class MapPicture {
 
  private:
   struct Overlay {
-    enum Kind { kPolyline, kCircle, kMarker, kText } kind;
+    enum Kind { kPolyline, kCircle, kMarker, kText, kArrow } kind;
     std::vector<Eigen::Vector2d> points;
     double radius = 0;
     Rgb color;
@@ -108,9 +116,11 @@ class MapPicture {
 
 // The evaluator's map.png: the map over the world's area (MapView::of_world), the ground truth's
 // walls the map does not know (when `gt` is given), and the flown trajectory with its start and
-// end. Overlays added to the result before writing it draw on top (roadmap, regions).
+// end. `beneath` adds overlays under the trajectory (the roadmap, the regions); overlays added
+// to the result draw on top.
 MapPicture run_map_picture(const mapper::StateGrid& grid, const simulator::World& world,
                            const simulator::GroundTruth* gt, const std::vector<Eigen::Vector3d>& trajectory,
-                           const std::string& title);
+                           const std::string& title,
+                           const std::function<void(MapPicture&)>& beneath = nullptr);
 
 }  // namespace semx::evaluator

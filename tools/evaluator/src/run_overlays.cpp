@@ -1,0 +1,80 @@
+#include "semx/evaluator/run_overlays.hpp"
+
+#include <octomap/OcTree.h>
+
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "semx/mapper/voxel_key.hpp"
+
+namespace semx::evaluator {
+
+namespace {
+constexpr Rgb kEdge{170, 190, 220};
+constexpr Rgb kNode{60, 90, 200};
+constexpr Rgb kFrontierNode{240, 150, 0};
+constexpr Rgb kActiveRegion{200, 0, 160};
+constexpr Rgb kDoneRegion{120, 120, 120};
+constexpr int32_t kOctoOffset = 32768;  // OctoMap's key of coordinate 0 at depth 16
+}  // namespace
+
+void add_roadmap(MapPicture& picture, const RoadmapOverlay& roadmap) {
+  for (const auto& [a, b] : roadmap.edges) picture.add_segment(a, b, kEdge, 1);
+  for (size_t i = 0; i < roadmap.nodes.size(); ++i) {
+    const bool frontier = i < roadmap.frontier.size() && roadmap.frontier[i];
+    picture.add_marker(roadmap.nodes[i], frontier ? kFrontierNode : kNode, "", 2);
+  }
+  if (!roadmap.nodes.empty()) {
+    picture.add_legend("roadmap (" + std::to_string(roadmap.nodes.size()) + " nodes)", kNode);
+  }
+}
+
+void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions) {
+  // A region still attracting the planner shows its reward radius; an observed one only where
+  // it is, so a finished run is not a tangle of circles.
+  for (const auto& r : regions) {
+    if (r.active) {
+      picture.add_circle(r.centre, r.radius, kActiveRegion, r.label, false, 1);
+    } else {
+      picture.add_marker(r.centre, kDoneRegion, r.label, 3);
+    }
+  }
+  if (!regions.empty()) {
+    picture.add_legend("semantic regions, active", kActiveRegion);
+    picture.add_legend("semantic regions, observed (" + std::to_string(regions.size()) + " in all)", kDoneRegion);
+  }
+}
+
+int64_t write_octomap_bt(const mapper::StateGrid& grid, const std::string& path) {
+  octomap::OcTree tree(grid.resolution());
+  const float occupied = static_cast<float>(tree.getClampingThresMaxLog());
+  const float free = static_cast<float>(tree.getClampingThresMinLog());
+  int64_t written = 0;
+  for (const mapper::VoxelKey& bk : grid.sorted_block_keys()) {
+    const mapper::VoxelBlock* b = grid.find_block(bk);
+    if (!b) continue;
+    for (int i = 0; i < mapper::kBlockVolume; ++i) {
+      const mapper::VoxelState s = b->state[i];
+      if (s == mapper::VoxelState::kUnknown) continue;
+      const mapper::VoxelKey k = mapper::voxel_of(bk, i);
+      if (k.x < -kOctoOffset || k.x >= kOctoOffset || k.y < -kOctoOffset || k.y >= kOctoOffset ||
+          k.z < -kOctoOffset || k.z >= kOctoOffset)
+        continue;
+      const octomap::OcTreeKey ok(static_cast<uint16_t>(k.x + kOctoOffset), static_cast<uint16_t>(k.y + kOctoOffset),
+                                  static_cast<uint16_t>(k.z + kOctoOffset));
+      tree.setNodeValue(ok, s == mapper::VoxelState::kOccupied ? occupied : free, /*lazy_eval=*/true);
+      ++written;
+    }
+  }
+  tree.updateInnerOccupancy();
+  // OctoMap reports progress on std::cout, which is the evaluator's progress console.
+  std::ostringstream chatter;
+  std::streambuf* const cout_buf = std::cout.rdbuf(chatter.rdbuf());
+  const bool ok = tree.writeBinary(path);
+  std::cout.rdbuf(cout_buf);
+  if (!ok) throw std::runtime_error("octomap file '" + path + "': cannot write");
+  return written;
+}
+
+}  // namespace semx::evaluator
