@@ -1,0 +1,53 @@
+// The paper's experiment as tables and plots: run folders of many explorations (one per world,
+// planner, sampling density and seed, each with metrics.json and coverage.csv) summarised as
+// mean ± std over seeds in the layout of the paper's Table II (sampling-density sweep) and
+// Table III (planner comparison), a CSV of every run, and one coverage-over-time plot per world
+// with every planner.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace semx::evaluator {
+
+struct BenchRun {
+  std::string dir;  // the run folder
+  std::string world, planner, termination;
+  int64_t seed = 0;
+  int samples = 0;
+  double time_f_s = 0, distance_m = 0, coverage_pct = 0, wall_s = 0, sim_s = 0;
+  std::optional<double> time_r_s;  // never reached 85 %
+  int64_t collisions = 0;
+  std::vector<std::pair<double, double>> coverage;  // (t s, %)
+};
+
+// Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
+BenchRun load_bench_run(const std::string& dir);
+// Every run folder below `root` (any depth) that has a metrics.json, sorted by path.
+std::vector<BenchRun> load_bench_runs(const std::string& root);
+
+struct Stat {
+  double mean = 0, std = 0;  // sample standard deviation (0 for one value)
+  int n = 0;
+};
+Stat stat_of(const std::vector<double>& values);
+
+struct BenchReportOptions {
+  std::string sweep_planner = "semantic-dep";  // the planner of the sampling-density table
+  int comparison_samples = 45;                 // the density of the planner comparison
+  double threshold_pct = 85.0;
+};
+
+// Markdown: the sweep table, the comparison table, and semantic-dep's margins over each
+// baseline (Time_f, Time_r, Distance, in %), each world in the order the runs name them.
+std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
+// One row per run (the columns of metrics.csv plus the folder).
+std::string bench_csv(const std::vector<BenchRun>& runs);
+// DIR/coverage_WORLD.png per world: the mean coverage curve over seeds of every planner at the
+// comparison density. Returns the files written.
+std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
+                                           const BenchReportOptions& options = {});
+
+}  // namespace semx::evaluator

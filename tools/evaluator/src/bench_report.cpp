@@ -1,0 +1,312 @@
+#include "semx/evaluator/bench_report.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "semx/evaluator/coverage_plot.hpp"
+
+namespace semx::evaluator {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep"};
+
+int planner_rank(const std::string& p) {
+  const auto it = std::find(kPlannerOrder.begin(), kPlannerOrder.end(), p);
+  return it == kPlannerOrder.end() ? static_cast<int>(kPlannerOrder.size()) : static_cast<int>(it - kPlannerOrder.begin());
+}
+
+std::vector<std::string> planners_of(const std::vector<const BenchRun*>& runs) {
+  std::vector<std::string> out;
+  for (const auto* r : runs)
+    if (std::find(out.begin(), out.end(), r->planner) == out.end()) out.push_back(r->planner);
+  std::stable_sort(out.begin(), out.end(), [](const std::string& a, const std::string& b) {
+    return planner_rank(a) != planner_rank(b) ? planner_rank(a) < planner_rank(b) : a < b;
+  });
+  return out;
+}
+
+std::vector<std::string> worlds_of(const std::vector<BenchRun>& runs) {
+  std::set<std::string> s;
+  for (const auto& r : runs) s.insert(r.world);
+  return {s.begin(), s.end()};
+}
+
+std::string fmt(double v, int decimals = 2) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  return b;
+}
+
+std::string pm(const Stat& s, int decimals = 2) {
+  if (s.n == 0) return "N/A";
+  return s.n == 1 ? fmt(s.mean, decimals) : fmt(s.mean, decimals) + " ± " + fmt(s.std, decimals);
+}
+
+struct Group {
+  std::vector<const BenchRun*> runs;
+  Stat metric(double BenchRun::*field) const {
+    std::vector<double> v;
+    for (const auto* r : runs) v.push_back(r->*field);
+    return stat_of(v);
+  }
+  // Time_r over the runs that reached the threshold; `reached` of `runs.size()` did.
+  Stat time_r(int* reached) const {
+    std::vector<double> v;
+    for (const auto* r : runs)
+      if (r->time_r_s) v.push_back(*r->time_r_s);
+    *reached = static_cast<int>(v.size());
+    return stat_of(v);
+  }
+  int64_t collisions() const {
+    int64_t c = 0;
+    for (const auto* r : runs) c += r->collisions;
+    return c;
+  }
+};
+
+std::string time_r_cell(const Group& g) {
+  int reached = 0;
+  const Stat s = g.time_r(&reached);
+  if (reached == 0) return "N/A";
+  std::string cell = pm(s);
+  if (reached < static_cast<int>(g.runs.size()))
+    cell += " (" + std::to_string(reached) + "/" + std::to_string(g.runs.size()) + ")";
+  return cell;
+}
+
+Group select(const std::vector<BenchRun>& runs, const std::string& world, const std::string& planner, int samples) {
+  Group g;
+  for (const auto& r : runs)
+    if (r.world == world && r.planner == planner && r.samples == samples) g.runs.push_back(&r);
+  std::sort(g.runs.begin(), g.runs.end(), [](const BenchRun* a, const BenchRun* b) { return a->seed < b->seed; });
+  return g;
+}
+
+std::string csv_escape(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+double number_of(const YAML::Node& n, const char* key, const std::string& file) {
+  const YAML::Node v = n[key];
+  if (!v || v.IsNull()) throw std::runtime_error(file + ": no '" + key + "'");
+  try {
+    return v.as<double>();
+  } catch (const std::exception&) {
+    throw std::runtime_error(file + ": '" + key + "' is not a number");
+  }
+}
+
+}  // namespace
+
+Stat stat_of(const std::vector<double>& values) {
+  Stat s;
+  s.n = static_cast<int>(values.size());
+  if (s.n == 0) return s;
+  for (double v : values) s.mean += v;
+  s.mean /= s.n;
+  if (s.n > 1) {
+    double ss = 0;
+    for (double v : values) ss += (v - s.mean) * (v - s.mean);
+    s.std = std::sqrt(ss / (s.n - 1));
+  }
+  return s;
+}
+
+BenchRun load_bench_run(const std::string& dir) {
+  BenchRun r;
+  r.dir = dir;
+  const std::string file = (fs::path(dir) / "metrics.json").string();
+  YAML::Node m;
+  try {
+    m = YAML::LoadFile(file);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(file + ": " + e.what());
+  }
+  if (!m.IsMap()) throw std::runtime_error(file + ": not a JSON object");
+  auto text = [&](const char* key) { return m[key] && m[key].IsScalar() ? m[key].as<std::string>() : std::string(); };
+  r.world = text("world");
+  r.planner = text("planner");
+  r.termination = text("termination");
+  if (r.world.empty() || r.planner.empty()) throw std::runtime_error(file + ": no world or planner");
+  r.seed = m["seed"] && !m["seed"].IsNull() ? m["seed"].as<int64_t>() : 0;
+  r.samples = m["samples"] && !m["samples"].IsNull() ? m["samples"].as<int>() : 0;
+  r.time_f_s = number_of(m, "time_f_s", file);
+  r.distance_m = number_of(m, "distance_m", file);
+  r.coverage_pct = number_of(m, "coverage_pct", file);
+  r.wall_s = number_of(m, "wall_s", file);
+  r.sim_s = m["sim_s"] && !m["sim_s"].IsNull() ? m["sim_s"].as<double>() : r.time_f_s;
+  r.collisions = static_cast<int64_t>(number_of(m, "collisions", file));
+  if (m["time_r_s"] && !m["time_r_s"].IsNull()) r.time_r_s = m["time_r_s"].as<double>();
+
+  const std::string csv = (fs::path(dir) / "coverage.csv").string();
+  std::ifstream in(csv);
+  if (in) {
+    std::string line;
+    int line_no = 0;
+    while (std::getline(in, line)) {
+      ++line_no;
+      if (line_no == 1 || line.empty()) continue;  // header
+      double t = 0, c = 0;
+      if (std::sscanf(line.c_str(), "%lf,%lf", &t, &c) != 2 || !std::isfinite(t) || !std::isfinite(c))
+        throw std::runtime_error(csv + ":" + std::to_string(line_no) + ": expected t_s,coverage_pct,...");
+      r.coverage.emplace_back(t, c);
+    }
+  }
+  return r;
+}
+
+std::vector<BenchRun> load_bench_runs(const std::string& root) {
+  std::vector<std::string> dirs;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file() && it->path().filename() == "metrics.json")
+      dirs.push_back(it->path().parent_path().string());
+  }
+  if (ec) throw std::runtime_error(root + ": " + ec.message());
+  std::sort(dirs.begin(), dirs.end());
+  std::vector<BenchRun> runs;
+  for (const auto& d : dirs) runs.push_back(load_bench_run(d));
+  return runs;
+}
+
+std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
+  std::ostringstream md;
+  const auto worlds = worlds_of(runs);
+  std::set<int> densities;
+  for (const auto& r : runs)
+    if (r.planner == o.sweep_planner) densities.insert(r.samples);
+
+  md << "### Sampling density (" << o.sweep_planner << "), mean ± std over seeds\n\n"
+     << "| Env. | no. S. | seeds | Time_f (s) | Distance (m) | Coverage (%) | Time_r (s) | collisions |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  for (const auto& w : worlds) {
+    for (int n : densities) {
+      const Group g = select(runs, w, o.sweep_planner, n);
+      if (g.runs.empty()) continue;
+      md << "| " << w << " | " << n << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s)) << " | "
+         << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct)) << " | "
+         << time_r_cell(g) << " | " << g.collisions() << " |\n";
+    }
+  }
+
+  md << "\n### Planners at " << o.comparison_samples << " samples, mean ± std over seeds\n\n"
+     << "| Env. | Algorithm | seeds | Time_f (s) | Distance (m) | Coverage (%) | Time_r (s) | collisions |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  for (const auto& w : worlds) {
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    for (const auto& p : planners_of(here)) {
+      const Group g = select(runs, w, p, o.comparison_samples);
+      md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s)) << " | "
+         << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct)) << " | "
+         << time_r_cell(g) << " | " << g.collisions() << " |\n";
+    }
+  }
+
+  md << "\n### " << o.sweep_planner << " against each baseline (difference of the means; negative time and "
+     << "distance are better)\n\n"
+     << "| Env. | vs | Time_f | Time_r | Distance | Coverage (points) |\n|---|---|---|---|---|---|\n";
+  auto pct = [](double ours, double theirs) {
+    if (!(std::fabs(theirs) > 1e-9)) return std::string("–");
+    const double d = 100.0 * (ours - theirs) / theirs;
+    return (d >= 0 ? "+" : "") + fmt(d, 1) + " %";
+  };
+  for (const auto& w : worlds) {
+    const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
+    if (ours.runs.empty()) continue;
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    for (const auto& p : planners_of(here)) {
+      if (p == o.sweep_planner) continue;
+      const Group theirs = select(runs, w, p, o.comparison_samples);
+      int ro = 0, rt = 0;
+      const Stat tro = ours.time_r(&ro), trt = theirs.time_r(&rt);
+      const std::string time_r = ro == 0 || rt == 0 ? (ro > 0 ? "only ours reached 85 %" : rt > 0 ? "only theirs reached 85 %" : "–")
+                                                     : pct(tro.mean, trt.mean);
+      const double dc = ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
+      md << "| " << w << " | " << p << " | " << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean)
+         << " | " << time_r << " | "
+         << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
+         << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
+    }
+  }
+  double wall = 0, sim = 0;
+  for (const auto& r : runs) {
+    wall += r.wall_s;
+    sim += r.sim_s;
+  }
+  md << "\n" << runs.size() << " runs, " << fmt(sim, 0) << " simulated s in " << fmt(wall, 0)
+     << " wall s of exploration (" << fmt(wall > 0 ? sim / wall : 0, 1) << "x real time).\n";
+  return md.str();
+}
+
+std::string bench_csv(const std::vector<BenchRun>& runs) {
+  std::ostringstream c;
+  c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,termination,dir\n";
+  for (const auto& r : runs) {
+    c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
+      << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
+      << (r.time_r_s ? fmt(*r.time_r_s, 3) : std::string()) << ',' << r.collisions << ',' << fmt(r.wall_s, 2) << ','
+      << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << '\n';
+  }
+  return c.str();
+}
+
+std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
+                                           const BenchReportOptions& o) {
+  std::vector<std::string> written;
+  for (const auto& w : worlds_of(runs)) {
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    if (here.empty()) continue;
+    std::vector<PlotSeries> series;
+    double t_max = 0;
+    for (const auto* r : here) t_max = std::max(t_max, r->coverage.empty() ? 0.0 : r->coverage.back().first);
+    for (const auto& p : planners_of(here)) {
+      const Group g = select(runs, w, p, o.comparison_samples);
+      // The mean over seeds at 1 s steps; a run that ended holds its final coverage.
+      PlotSeries s;
+      s.label = p + " (" + std::to_string(g.runs.size()) + (g.runs.size() == 1 ? " seed)" : " seeds)");
+      for (double t = 0; t <= t_max + 1e-9; t += 1.0) {
+        double sum = 0;
+        for (const auto* r : g.runs) {
+          double v = 0;
+          for (const auto& [ts, c] : r->coverage) {
+            if (ts > t + 1e-9) break;
+            v = c;
+          }
+          sum += v;
+        }
+        s.points.emplace_back(t, sum / static_cast<double>(g.runs.size()));
+      }
+      series.push_back(std::move(s));
+    }
+    CoveragePlotOptions po;
+    po.title = w + ": coverage over time, mean over seeds (" + std::to_string(o.comparison_samples) + " samples)";
+    po.threshold_pct = o.threshold_pct;
+    const std::string file = (fs::path(dir) / ("coverage_" + w + ".png")).string();
+    write_coverage_plot(file, series, po);
+    written.push_back(file);
+  }
+  return written;
+}
+
+}  // namespace semx::evaluator
