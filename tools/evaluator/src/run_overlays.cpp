@@ -2,8 +2,10 @@
 
 #include <octomap/OcTree.h>
 
-#include <iostream>
-#include <sstream>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
 #include <stdexcept>
 
 #include "semx/mapper/voxel_key.hpp"
@@ -68,11 +70,19 @@ int64_t write_octomap_bt(const mapper::StateGrid& grid, const std::string& path)
     }
   }
   tree.updateInnerOccupancy();
-  // OctoMap reports progress on std::cout, which is the evaluator's progress console.
-  std::ostringstream chatter;
-  std::streambuf* const cout_buf = std::cout.rdbuf(chatter.rdbuf());
+  // Debian's liboctomap reports " done." with fprintf(stderr) on every write, which would land
+  // in the middle of the evaluator's final table: stderr goes to /dev/null for the call.
+  std::fflush(stderr);
+  const int saved = dup(STDERR_FILENO);
+  const int null_fd = open("/dev/null", O_WRONLY);
+  if (saved >= 0 && null_fd >= 0) dup2(null_fd, STDERR_FILENO);
   const bool ok = tree.writeBinary(path);
-  std::cout.rdbuf(cout_buf);
+  std::fflush(stderr);
+  if (saved >= 0) {
+    dup2(saved, STDERR_FILENO);
+    close(saved);
+  }
+  if (null_fd >= 0) close(null_fd);
   if (!ok) throw std::runtime_error("octomap file '" + path + "': cannot write");
   return written;
 }
