@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "evaluator_node.hpp"
 #include "scene.hpp"
@@ -85,10 +86,16 @@ TEST_F(EvaluatorNodeTest, LockstepRunEndsAtThePlannersDoneWithTheFolderComplete)
   EXPECT_EQ(s.collisions, 1);
   EXPECT_EQ(r.state, runtime::NodeState::kDone);
 
-  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "coverage.png", "map.png"}) {
+  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "coverage.png", "map.png", "map.bt"}) {
     EXPECT_TRUE(fs::is_regular_file(fs::path(r.dir) / f)) << f;
   }
-  EXPECT_EQ(r.written.size(), 5u);
+  EXPECT_EQ(r.written.size(), 6u);
+  {
+    std::ifstream bt(r.dir + "/map.bt");
+    std::string first;
+    std::getline(bt, first);
+    EXPECT_EQ(first, "# Octomap OcTree binary file") << "octovis reads it";
+  }
   const YAML::Node j = YAML::LoadFile(r.dir + "/metrics.json");
   EXPECT_EQ(j["world"].as<std::string>(), "small");
   EXPECT_EQ(j["seed"].as<int>(), 7);

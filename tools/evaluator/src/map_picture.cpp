@@ -163,7 +163,8 @@ Image MapPicture::render() const {
         if (o.filled) {
           // Blend only the circle's box: the same pixels as blending the whole image, at a
           // cost that does not grow with the picture (the viewer draws many regions a frame).
-          const cv::Rect box = cv::Rect(p.x - r - 2, p.y - r - 2, 2 * r + 5, 2 * r + 5) & cv::Rect(0, 0, W, H);
+          const cv::Rect box =
+              cv::Rect(p.x - r - 2, p.y - r - 2, 2 * r + 5, 2 * r + 5) & cv::Rect(0, 0, W, H);
           if (box.area() > 0) {
             cv::Mat roi = img(box);
             cv::Mat layer = roi.clone();

@@ -45,7 +45,7 @@ struct MapPictureOptions {
   // > 0: exactly this many pixels per voxel column, whatever max_side_px says (a fixed scale,
   // e.g. the viewer's --scale, so frames of one run line up).
   int pixels_per_column = 0;
-  int margin_px = 36;      // room for the title, scale bar and legend
+  int margin_px = 36;  // room for the title, scale bar and legend
   std::string title;
   bool legend = true;
   Rgb free{245, 245, 240};
