@@ -21,7 +21,8 @@ semx::imu_t to_message(const ImuSample& s);
 semx::camera_info_t camera_info(const CameraFrame& f);
 
 // Images as little-endian bytes, encoded with the requested codec (runtime/image_codec.hpp;
-// the codec actually used is in the message, raw when encoding would not shrink it).
+// the codec actually used is in the message, raw when encoding would not shrink it). RGB comes
+// from f.rgb_runs when the frame has runs and no image (kRenderRgbRuns), with the same payload.
 semx::depth_image_t depth_message(const CameraFrame& f, runtime::ImageCompression codec);
 semx::rgb_image_t rgb_message(const CameraFrame& f, runtime::ImageCompression codec);
 semx::label_image_t label_message(const CameraFrame& f, runtime::ImageCompression codec);

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     if (compress && raw) throw runtime::ArgError("--compress and --raw-images exclude each other");
     if (compress) o.depth_codec = o.label_codec = o.rgb_codec = runtime::ImageCompression::kZlib;
     if (raw) o.label_codec = o.rgb_codec = runtime::ImageCompression::kNone;
-    o.render_channels = no_rgb ? (simulator::kRenderDepth | simulator::kRenderLabels) : simulator::kRenderAll;
+    if (no_rgb) o.render_channels = simulator::kRenderDepth | simulator::kRenderLabels;
     o.progress_every_s = progress;
 
     auto node_options = flags.options();

@@ -51,7 +51,7 @@ void SimulatorNode::publish_event(int8_t type, const std::string& text, const Ei
 void SimulatorNode::publish_frame() {
   sim_.render_camera(frame_, options_.render_channels);
   if (frame_.channels & kRenderDepth) node_.publish(ch::CAMERA_DEPTH, depth_message(frame_, options_.depth_codec));
-  if (frame_.channels & kRenderRgb) node_.publish(ch::CAMERA_RGB, rgb_message(frame_, options_.rgb_codec));
+  if (frame_.channels & (kRenderRgb | kRenderRgbRuns)) node_.publish(ch::CAMERA_RGB, rgb_message(frame_, options_.rgb_codec));
   if (frame_.channels & kRenderLabels) node_.publish(ch::CAMERA_LABELS, label_message(frame_, options_.label_codec));
   ++frames_;
 }

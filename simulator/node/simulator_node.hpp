@@ -24,7 +24,8 @@ struct SimulatorNodeOptions {
   runtime::ImageCompression depth_codec = runtime::ImageCompression::kNone;
   runtime::ImageCompression label_codec = runtime::ImageCompression::kRle;
   runtime::ImageCompression rgb_codec = runtime::ImageCompression::kRle;
-  unsigned render_channels = kRenderAll;
+  // RGB as runs: the same image and payload, without an image to write and scan.
+  unsigned render_channels = kRenderDepth | kRenderLabels | kRenderRgbRuns;
   double progress_every_s = 10.0;    // simulated seconds between progress lines (0: none)
 };
 

@@ -126,8 +126,10 @@ void RayCaster::render(const runtime::PinholeCamera& camera, const Eigen::Isomet
     out.class_label.resize(w, h);
     out.instance_label.resize(w, h);
   }
-  if (channels & kRenderRgb) out.rgb.resize(w, h);
-  const double far = std::max(camera.max_range, (channels & kRenderRgb) ? rgb_far : 0.0);
+  // Runs are derived from the image here: the reference renderer need not be fast.
+  const bool rgb = channels & (kRenderRgb | kRenderRgbRuns);
+  if (rgb) out.rgb.resize(w, h);
+  const double far = std::max(camera.max_range, rgb ? rgb_far : 0.0);
   const Eigen::Vector3d origin = pose.translation();
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
@@ -149,12 +151,13 @@ void RayCaster::render(const runtime::PinholeCamera& camera, const Eigen::Isomet
         out.class_label.at(u, v) = s ? static_cast<uint16_t>(s->cls) : 0;
         out.instance_label.at(u, v) = s ? s->instance : 0;
       }
-      if (channels & kRenderRgb) {
+      if (rgb) {
         out.rgb.at(u, v) =
             hit ? WorldMesh::shade(world_.solids[hit->solid].color, hit->normal) : kBackgroundRgb;
       }
     }
   }
+  if (channels & kRenderRgbRuns) out.rgb_runs = rgb_runs(out.rgb);
 }
 
 }  // namespace semx::simulator

@@ -150,6 +150,80 @@ TEST(SimulatorNode, CompressedImagesRoundTrip) {
   EXPECT_FALSE(image_bytes(0, std::vector<uint8_t>{1, 2, 3}, 100, out));
 }
 
+// The node encodes RGB from runs and labels from their two planes, not through
+// runtime::encode_image: the payloads must be the very bytes encode_image gives for the image.
+TEST(SimulatorNode, FastEncodersGiveTheCodecsPayloads) {
+  using runtime::ImageCompression;
+  auto packed_labels = [](const CameraFrame& f) {
+    std::vector<uint8_t> raw;
+    for (std::size_t i = 0; i < f.class_label.data.size(); ++i) {
+      for (uint16_t v : {f.class_label.data[i], f.instance_label.data[i]}) {
+        raw.push_back(static_cast<uint8_t>(v & 0xFF));
+        raw.push_back(static_cast<uint8_t>(v >> 8));
+      }
+    }
+    return raw;
+  };
+  auto expect_same = [&](const CameraFrame& image, const CameraFrame& runs) {
+    for (auto codec : {ImageCompression::kRle, ImageCompression::kNone, ImageCompression::kZlib}) {
+      SCOPED_TRACE(static_cast<int>(codec));
+      const auto a = rgb_message(image, codec), b = rgb_message(runs, codec);
+      EXPECT_EQ(a.rgb_compression, b.rgb_compression);
+      EXPECT_EQ(a.rgb_data, b.rgb_data);
+      ImageCompression used;
+      const auto want = runtime::encode_image(packed_labels(image), 4, codec, used);
+      const auto l = label_message(image, codec);
+      EXPECT_EQ(l.label_compression, static_cast<int8_t>(used));
+      EXPECT_EQ(l.label_data, want);
+    }
+  };
+
+  // Rendered frames, from the start pose of each world and from a few yaws.
+  for (const char* name : {"env1", "env2", "env3"}) {
+    SCOPED_TRACE(name);
+    SimulatorConfig cfg;
+    Simulator sim(test::shipped(name), cfg);
+    for (int k = 0; k < 3; ++k) {
+      CameraFrame image, runs;
+      sim.render_camera(image, kRenderAll);
+      sim.render_camera(runs, kRenderDepth | kRenderLabels | kRenderRgbRuns);
+      EXPECT_TRUE(runs.rgb.empty());
+      EXPECT_EQ(runs.rgb_runs, rgb_runs(image.rgb));
+      expect_same(image, runs);
+      sim.command(ControlCommand::velocity({0, 0, 0}, 1.5));
+      for (int i = 0; i < 300; ++i) sim.step();
+    }
+  }
+
+  // Made-up images: one colour (runs split at the 16-bit count), and noise RLE cannot shrink
+  // (sent raw, in both cases).
+  CameraFrame flat, flat_runs, noise, noise_runs;
+  for (CameraFrame* f : {&flat, &flat_runs, &noise, &noise_runs}) {
+    f->camera.width = 400;
+    f->camera.height = 300;
+    f->class_label.resize(400, 300);
+    f->instance_label.resize(400, 300);
+  }
+  flat.channels = noise.channels = kRenderLabels | kRenderRgb;
+  flat_runs.channels = noise_runs.channels = kRenderLabels | kRenderRgbRuns;
+  flat.rgb = Image<Rgb>(400, 300, Rgb{1, 2, 3});
+  noise.rgb.resize(400, 300);
+  uint32_t x = 12345;
+  for (std::size_t i = 0; i < noise.rgb.data.size(); ++i) {
+    x = x * 1664525u + 1013904223u;
+    noise.rgb.data[i] = Rgb{static_cast<uint8_t>(x >> 24), static_cast<uint8_t>(x >> 16), 7};
+    noise.class_label.data[i] = static_cast<uint16_t>(x >> 20);
+    noise.instance_label.data[i] = static_cast<uint16_t>(i / 3);
+  }
+  flat_runs.rgb_runs = rgb_runs(flat.rgb);
+  noise_runs.rgb_runs = rgb_runs(noise.rgb);
+  ASSERT_EQ(flat_runs.rgb_runs.size(), 1u);
+  expect_same(flat, flat_runs);
+  expect_same(noise, noise_runs);
+  EXPECT_EQ(rgb_message(noise_runs, ImageCompression::kRle).rgb_compression, 0) << "noise is sent raw";
+  EXPECT_EQ(label_message(noise, ImageCompression::kRle).label_compression, 0) << "noise is sent raw";
+}
+
 TEST(SimulatorNode, VelocityCommandsMoveTheVehicleAndBadOnesAreDropped) {
   double first_x = 0, last_x = 0;
   bool have_first = false;

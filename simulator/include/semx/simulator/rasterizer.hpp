@@ -40,16 +40,33 @@ class Rasterizer {
   size_t last_triangles_drawn() const { return drawn_; }
 
  private:
-  void draw_polygon(const Eigen::Vector3d* cam, int n, const runtime::PinholeCamera& camera, double a,
-                    double b, double c, uint32_t payload);
-  void resolve_depth(const runtime::PinholeCamera& camera, uint16_t* depth, size_t npx) const;
+  // A triangle, or the part of it in front of the near plane, set up for scan conversion.
+  static constexpr int kMaxPolygon = 4;  // clipping a triangle at one plane adds at most a vertex
+  struct Polygon {
+    struct Edge {
+      double ya, xa, yb, xb, slope;  // end points in pixels, the upper one first
+    };
+    Edge edges[kMaxPolygon];
+    int n = 0;
+    int j0 = 0, j1 = 0;          // rows covered, clamped to the image
+    double a = 0, b = 0, c = 0;  // 1/z = a (u - cx) + b (v - cy) + c
+    float wlo = 0, whi = 0;      // range of 1/z over the vertices
+    uint32_t payload = 0;
+  };
+  // Rows per band of the z-buffer: 16 rows of 640 pixels are 80 kB of depth and payload.
+  static constexpr int kBandRows = 16;
+
+  void setup_polygon(const Eigen::Vector3d* cam, int n, const runtime::PinholeCamera& camera, double a,
+                     double b, double c, uint32_t payload);
+  void draw_rows(const Polygon& p, int jlo, int jhi, int band_j0, const runtime::PinholeCamera& camera);
   static uint32_t pack_labels(uint16_t cls, uint16_t instance) {
     return cls | (static_cast<uint32_t>(instance) << 16);
   }
 
   WorldMesh mesh_;
   RasterizerOptions options_;
-  std::vector<float> zbuf_;              // 1/z, 0 = nothing
+  std::vector<Polygon> polygons_;        // this frame's, in drawing order
+  std::vector<float> zbuf_;              // one band's 1/z, 0 = nothing
   std::vector<uint32_t> idbuf_;          // winner: its triangle index (RGB renders) or packed labels
   std::vector<uint32_t> packed_labels_;  // per triangle: class | instance << 16
   std::vector<Eigen::Vector3d> cam_vertices_;
