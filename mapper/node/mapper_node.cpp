@@ -1,9 +1,11 @@
 #include "mapper_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <system_error>
 
 #include "semx/runtime/channels.hpp"
@@ -34,6 +36,19 @@ bool due(int64_t now, int64_t& next, double period_s) {
   return true;
 }
 
+// Whether due() would say yes, without scheduling anything.
+bool would_be_due(int64_t now, int64_t next, double period_s) {
+  return period_s > 0 && (next < 0 || now >= next);
+}
+
+template <class T>
+std::vector<uint8_t> encode(const T& m) {
+  const int size = m.getEncodedSize();
+  std::vector<uint8_t> bytes(static_cast<size_t>(std::max(size, 0)));
+  if (size > 0 && m.encode(bytes.data(), 0, size) != size) bytes.clear();
+  return bytes;
+}
+
 }  // namespace
 
 MapperNode::MapperNode(runtime::Node& node, const MapperConfig& config, MapperNodeOptions options)
@@ -48,6 +63,15 @@ MapperNode::MapperNode(runtime::Node& node, const MapperConfig& config, MapperNo
   node_.subscribe<semx::map_request_t>(
       ch::MAP_REQUEST, [this](const semx::map_request_t& m) { on_request(m); }, &accept_request);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+}
+
+MapperNode::~MapperNode() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    quit_ = true;
+  }
+  work_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
 }
 
 void MapperNode::restore_checkpoint() {
@@ -101,37 +125,115 @@ bool MapperNode::accept_depth(const semx::depth_image_t& m) {
   return false;
 }
 
+bool MapperNode::pipelined() const {
+  return mapper_.config().streaming.lockstep_delay > 0 && node_.clock().started() &&
+         node_.clock().mode() == runtime::ClockMode::kLockstep;
+}
+
 void MapperNode::on_depth(const semx::depth_image_t& m) {
+  auto job = std::make_shared<Job>();
+  job->now = have_time_ ? std::max(now_, m.utime) : m.utime;
+  // Around the vehicle; before the first odometry, around the camera.
+  job->center = vehicle_ ? *vehicle_ : Eigen::Vector3d(decoded_.T_world_optical.translation());
+  if (!pipelined()) {
+    std::swap(job->frame, decoded_);  // borrowed: decoded_ keeps its buffer for the next frame
+    compute(*job);
+    finish(*job);
+    std::swap(job->frame, decoded_);
+    periodic();
+    return;
+  }
+  job->frame = std::move(decoded_);
+  in_flight_.push_back(job);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(job);
+  }
+  if (!worker_.joinable()) worker_ = std::thread([this] { worker_loop(); });
+  work_cv_.notify_one();
+}
+
+void MapperNode::compute(Job& job) {
+  job.result = mapper_.integrate(job.frame.frame());
+  if (!job.result.report.accepted) return;
+  job.update_bytes = encode(to_message(job.result.delta));
+  const MapperConfig& cfg = mapper_.config();
+  if (cfg.esdf.enabled &&
+      (cfg.streaming.esdf_period <= 0 || due(job.now, next_esdf_, cfg.streaming.esdf_period))) {
+    job.esdf = true;
+    if (mapper_.update_esdf(job.center)) {
+      job.esdf_recomputed = true;
+      job.esdf_ms = mapper_.esdf_ms();
+    }
+    job.esdf_bytes = encode(to_message(mapper_.esdf(), job.frame.utime));
+  }
+}
+
+void MapperNode::finish(Job& job) {
   ++counters_.frames_received;
-  const FrameResult r = mapper_.integrate(decoded_.frame());
+  const FrameResult& r = job.result;
   counters_.integrate_ms += r.integrate_ms;
   if (!r.report.accepted) {
     ++counters_.frames_rejected;
     if (!options_.quiet && worth_logging(counters_.frames_rejected)) {
-      std::cerr << node_.name() << ": depth frame at utime " << m.utime << " rejected: " << r.report.error
-                << " (" << counters_.frames_rejected << " so far)\n";
+      std::cerr << node_.name() << ": depth frame at utime " << job.frame.utime
+                << " rejected: " << r.report.error << " (" << counters_.frames_rejected << " so far)\n";
     }
     return;
   }
-  if (!have_time_ || m.utime > now_) now_ = m.utime;
+  if (!have_time_ || job.frame.utime > now_) now_ = job.frame.utime;
   have_time_ = true;
-  node_.publish(ch::MAP_UPDATE, to_message(r.delta));
+  node_.publish_raw(ch::MAP_UPDATE, job.update_bytes.data(), job.update_bytes.size());
   ++counters_.updates;
-
-  const MapperConfig& cfg = mapper_.config();
-  if (cfg.esdf.enabled &&
-      (cfg.streaming.esdf_period <= 0 || due(now_, next_esdf_, cfg.streaming.esdf_period))) {
-    // Around the vehicle; before the first odometry, around the camera.
-    const Eigen::Vector3d center =
-        vehicle_ ? *vehicle_ : Eigen::Vector3d(decoded_.T_world_optical.translation());
-    if (mapper_.update_esdf(center)) {
+  if (job.esdf) {
+    if (job.esdf_recomputed) {
       ++counters_.esdf_recomputes;
-      counters_.esdf_ms += mapper_.esdf_ms();
+      counters_.esdf_ms += job.esdf_ms;
     }
-    node_.publish(ch::ESDF_LOCAL, to_message(mapper_.esdf(), m.utime));
+    node_.publish_raw(ch::ESDF_LOCAL, job.esdf_bytes.data(), job.esdf_bytes.size());
     ++counters_.esdfs;
   }
-  periodic();
+}
+
+void MapperNode::worker_loop() {
+  for (;;) {
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      work_cv_.wait(lock, [this] { return quit_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // quitting, and nothing left to do
+      job = queue_.front();
+      queue_.pop_front();
+    }
+    compute(*job);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      job->done = true;
+    }
+    done_cv_.notify_all();
+  }
+}
+
+void MapperNode::publish_done(int64_t up_to_utime) {
+  while (!in_flight_.empty() && in_flight_.front()->frame.utime <= up_to_utime) {
+    const std::shared_ptr<Job> job = in_flight_.front();
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      done_cv_.wait(lock, [&] { return job->done; });
+    }
+    in_flight_.pop_front();
+    finish(*job);
+  }
+}
+
+void MapperNode::flush_frames() { publish_done(std::numeric_limits<int64_t>::max()); }
+
+bool MapperNode::periodic_due() const {
+  const StreamingParams& st = mapper_.config().streaming;
+  const double cp = mapper_.config().checkpoint.period;
+  return would_be_due(now_, next_snapshot_, st.snapshot_period) ||
+         would_be_due(now_, next_stats_, st.stats_period) ||
+         (!checkpoint_path_.empty() && cp > 0 && next_checkpoint_ >= 0 && now_ >= next_checkpoint_);
 }
 
 void MapperNode::on_odometry(const semx::odometry_t& m) {
@@ -142,6 +244,7 @@ void MapperNode::on_request(const semx::map_request_t& /*m*/) {
   ++counters_.requests;
   const bool lockstep = node_.clock().started() && node_.clock().mode() == runtime::ClockMode::kLockstep;
   if (!lockstep) {
+    flush_frames();
     publish_snapshot();
     return;
   }
@@ -154,11 +257,21 @@ void MapperNode::on_request(const semx::map_request_t& /*m*/) {
 void MapperNode::on_tick(int64_t tick, int64_t utime) {
   if (tick == 0 && have_time_ && utime < now_) {
     // The clock restarted (a new episode): the map stays, the schedules start again.
+    flush_frames();
     now_ = utime;
     next_stats_ = next_snapshot_ = next_esdf_ = next_checkpoint_ = -1;
   }
   if (!have_time_ || utime > now_) now_ = utime;
   have_time_ = true;
+  if (!in_flight_.empty()) {
+    // Outputs that read the map describe the map of the last MAP_UPDATE sent: publish every
+    // frame first. Otherwise only the frames whose delay has passed.
+    if (request_pending_ || periodic_due()) {
+      flush_frames();
+    } else {
+      publish_done(utime - period_us(mapper_.config().streaming.lockstep_delay));
+    }
+  }
   if (request_pending_) publish_snapshot();
   periodic();
 }
@@ -166,17 +279,20 @@ void MapperNode::on_tick(int64_t tick, int64_t utime) {
 void MapperNode::poll_wall() {
   if (request_pending_ && std::chrono::steady_clock::now() - request_since_ >
                               std::chrono::duration<double>(options_.request_grace_s)) {
+    flush_frames();
     publish_snapshot();
   }
 }
 
 void MapperNode::publish_snapshot() {
+  flush_frames();  // the worker owns the map while frames are in flight
   node_.publish(ch::MAP_SNAPSHOT, to_message(mapper_.snapshot(now_)));
   ++counters_.snapshots;
   request_pending_ = false;
 }
 
 void MapperNode::publish_stats() {
+  flush_frames();
   MapStats s = mapper_.stats(true);
   s.frames_rejected += frames_malformed();
   node_.publish(ch::MAP_STATS, to_message(s, now_));
@@ -199,6 +315,7 @@ void MapperNode::periodic() {
 }
 
 bool MapperNode::checkpoint_now() {
+  flush_frames();
   if (checkpoint_path_.empty() || mapper_.seq() == checkpoint_seq_) return false;
   try {
     mapper_.save_checkpoint(checkpoint_path_, now_);
@@ -233,13 +350,18 @@ int MapperNode::run() {
     node_.set_state(runtime::NodeState::kRunning, "waiting for frames");
   int rc = 0;
   while (!node_.stopped()) {
-    if (node_.spin_once(100) < 0) {
+    const int got = node_.spin_once(100);
+    if (got < 0) {
       node_.set_state(runtime::NodeState::kFailed, "LCM provider failed");
       rc = 1;
       break;
     }
+    // 100 ms without a message while frames are in flight: the clock stopped (the simulator
+    // ended), so no tick will publish them.
+    if (got == 0 && !in_flight_.empty()) flush_frames();
     poll_wall();
   }
+  flush_frames();
   checkpoint_now();
   if (rc == 0)
     node_.set_state(runtime::NodeState::kStopping, runtime::shutdown_requested() ? "signal" : "stopped");

@@ -13,9 +13,15 @@
 // checked by the subscription's accept predicate, so a frame that is not a frame counts as
 // malformed (NODE_STATUS) and changes nothing.
 //
-// Determinism in LOCKSTEP: the simulator publishes a tick's frames before SIM_CLOCK(k); the
-// handlers publish MAP_UPDATE/ESDF_LOCAL as they run and the periodic outputs run in the tick
-// handler, all before the Node acks k. MAP_REQUESTs received while following a LOCKSTEP clock are
+// Determinism in LOCKSTEP: the simulator publishes a tick's frames before SIM_CLOCK(k). With
+// streaming.lockstep_delay = 0 the handlers publish MAP_UPDATE/ESDF_LOCAL as they run and the
+// periodic outputs run in the tick handler, all before the Node acks k. With a delay d > 0 (the
+// default) a frame received while following a LOCKSTEP clock goes to a worker thread at once,
+// and the tick handler of the first tick with utime >= frame utime + d waits for it and publishes
+// its outputs before the ack: which tick carries them depends on message time only. A tick that
+// is due to publish a snapshot, stats, a checkpoint or a requested snapshot first waits for and
+// publishes every frame received so far, so those always describe the map of the last published
+// MAP_UPDATE. MAP_REQUESTs received while following a LOCKSTEP clock are
 // answered in the next tick handler (so every run answers at the same tick); otherwise, or when
 // no tick comes within `request_grace_s` of wall time (the simulator ended), at once.
 #pragma once
@@ -26,9 +32,14 @@
 
 #include <Eigen/Core>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "messages.hpp"
 #include "semx/mapper/mapper.hpp"
@@ -70,6 +81,9 @@ class MapperNode {
   // ignore_bad_checkpoint, and runtime::ConfigError for an invalid config or a checkpoint
   // path whose directory does not exist.
   MapperNode(runtime::Node& node, const MapperConfig& config, MapperNodeOptions options = {});
+  ~MapperNode();
+  MapperNode(const MapperNode&) = delete;
+  MapperNode& operator=(const MapperNode&) = delete;
 
   // Spins the node until shutdown, then writes a last checkpoint; returns the exit code.
   int run();
@@ -81,7 +95,13 @@ class MapperNode {
   void poll_wall();
   // Writes the checkpoint now if there is a path and the map changed since the last one.
   bool checkpoint_now();
+  // Waits for the worker and publishes the outputs of every frame received so far (run() does it
+  // on exit; lockstep ticks do it when due). Afterwards mapper() is the map of the last MAP_UPDATE.
+  void flush_frames();
+  // Frames handed to the worker whose outputs are not published yet.
+  std::size_t frames_in_flight() const { return in_flight_.size(); }
 
+  // Call flush_frames() first when frames may be in flight (the worker owns the map meanwhile).
   const Mapper& mapper() const { return mapper_; }
   const Counters& counters() const { return counters_; }
   // CAMERA_DEPTH messages dropped before the integrator: malformed bytes, content that is not a
@@ -93,8 +113,28 @@ class MapperNode {
   int64_t now_utime() const { return now_; }
 
  private:
+  // One frame's work and outputs: computed on the worker (or inline), published on the node's
+  // thread.
+  struct Job {
+    DecodedDepth frame;
+    int64_t now = 0;         // node time once the frame is accepted
+    Eigen::Vector3d center;  // ESDF window centre (the latest odometry when the frame came)
+    FrameResult result;
+    bool esdf = false;  // ESDF_LOCAL goes out with this frame
+    bool esdf_recomputed = false;
+    double esdf_ms = 0.0;
+    std::vector<uint8_t> update_bytes, esdf_bytes;
+    bool done = false;  // set by the worker under mutex_
+  };
+
   bool accept_depth(const semx::depth_image_t& m);
   void on_depth(const semx::depth_image_t& m);
+  bool pipelined() const;
+  void compute(Job& job);  // integrate, ESDF, encode: touches the map, so one thread at a time
+  void finish(Job& job);   // counters, log lines, publication
+  void publish_done(int64_t up_to_utime);  // in-flight frames with utime <= this, in order
+  bool periodic_due() const;
+  void worker_loop();
   void on_odometry(const semx::odometry_t& m);
   void on_request(const semx::map_request_t& m);
   void publish_snapshot();
@@ -122,6 +162,16 @@ class MapperNode {
   bool checkpoint_failing_ = false;
   bool request_pending_ = false;
   std::chrono::steady_clock::time_point request_since_;
+
+  // Pipelined LOCKSTEP frames (streaming.lockstep_delay > 0). in_flight_ is the node thread's
+  // list, in arrival order; queue_ what the worker has yet to start. A Job's fields are written
+  // by the worker until `done`, then only read by the node thread.
+  std::deque<std::shared_ptr<Job>> in_flight_;
+  std::deque<std::shared_ptr<Job>> queue_;
+  std::mutex mutex_;
+  std::condition_variable work_cv_, done_cv_;
+  bool quit_ = false;
+  std::thread worker_;
 };
 
 }  // namespace semx::mapper

@@ -44,6 +44,7 @@ void load(runtime::ConfigMap& m, MapperConfig& c) {
   st.get("snapshot_period", c.streaming.snapshot_period, 0.0, 3600.0);
   st.get("stats_period", c.streaming.stats_period, 0.0, 3600.0);
   st.get("esdf_period", c.streaming.esdf_period, 0.0, 3600.0);
+  st.get("lockstep_delay", c.streaming.lockstep_delay, 0.0, 10.0);
 
   runtime::ConfigMap cp = m.child("checkpoint");
   cp.get("path", c.checkpoint.path);

@@ -119,6 +119,10 @@ void Node::ensure_lcm_subscription(const std::string& channel) {
   subs_[channel];
 }
 
+void Node::skip_unless(const std::string& channel, std::function<bool(int64_t utime)> wanted) {
+  skip_filters_[channel] = std::move(wanted);
+}
+
 void Node::subscribe_raw(const std::string& regex, RawHandler handler) {
   raw_handlers_.emplace_back(regex, std::move(handler));
   lcm_->subscribe(regex, &Node::on_raw_message, this);
@@ -153,6 +157,17 @@ void Node::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel
   }
   auto it = subs_.find(channel);
   if (it == subs_.end()) return;
+  if (!skip_filters_.empty() && size >= 16) {
+    const auto f = skip_filters_.find(channel);
+    if (f != skip_filters_.end()) {
+      uint64_t utime = 0;  // big-endian int64 right after the 8-byte fingerprint
+      for (int i = 8; i < 16; ++i) utime = (utime << 8) | data[i];
+      if (!f->second(static_cast<int64_t>(utime))) {
+        ++c.skipped;
+        return;
+      }
+    }
+  }
   bool malformed = false;
   for (auto& sub : it->second) {
     std::string why;

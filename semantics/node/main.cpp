@@ -45,6 +45,15 @@ int main(int argc, char** argv) {
     std::cout << "semx-semantics: " << sem.pipeline().detector().name() << " detector, K "
               << config.tracking.min_observations << " over " << config.tracking.min_duration_s << " s, on "
               << sem.node().url() << std::endl;
-    return sem.run();
+    const int rc = sem.run();
+    const auto& c = sem.counters();
+    std::printf(
+        "semx-semantics: %lld frames processed (%.2f ms each, wall), %lld skipped (frame_period_s %g s), "
+        "%lld rejected, %lld incomplete\n",
+        static_cast<long long>(c.frames_processed),
+        c.frames_processed ? c.process_ms / static_cast<double>(c.frames_processed) : 0.0,
+        static_cast<long long>(c.frames_skipped), config.detector.frame_period_s,
+        static_cast<long long>(c.frames_rejected), static_cast<long long>(c.frames_incomplete));
+    return rc;
   });
 }

@@ -6,9 +6,23 @@
 namespace semx::semantics {
 
 SemanticsNode::SemanticsNode(runtime::NodeOptions options, const SemanticsConfig& config)
-    : config_(config), node_(std::move(options)), pipeline_(config), publisher_(config.regions) {
+    : config_(config),
+      node_(std::move(options)),
+      pipeline_(config),
+      publisher_(config.regions),
+      gate_(config.detector.frame_period_s) {
   need_labels_ = pipeline_.detector().needs_labels();
   need_rgb_ = pipeline_.detector().needs_rgb();
+  // Captures that are not due are dropped from their bytes' utime, before the 0.3-1 MB images
+  // are validated, copied and decompressed. The gate changes only when a frame is processed, so
+  // every part of one capture (same utime) gets the same answer.
+  node_.skip_unless(semx::channels::CAMERA_DEPTH, [this](int64_t utime) {
+    if (gate_.due(utime)) return true;
+    ++counters_.frames_skipped;  // counted once per capture, on its depth part
+    return false;
+  });
+  node_.skip_unless(semx::channels::CAMERA_LABELS, [this](int64_t utime) { return gate_.due(utime); });
+  node_.skip_unless(semx::channels::CAMERA_RGB, [this](int64_t utime) { return gate_.due(utime); });
   node_.subscribe<semx::depth_image_t>(
       semx::channels::CAMERA_DEPTH,
       [this](const semx::depth_image_t& m) {
@@ -93,12 +107,14 @@ void SemanticsNode::complete(int64_t frame_id) {
   const Frame frame = std::move(it->second.frame);
   pending_.erase(it);
   const FrameStats s = pipeline_.process(frame);
+  counters_.process_ms += s.total_ms();
   if (!s.accepted) {
     ++counters_.frames_rejected;
     last_reject_ = s.reject_reason;
     return;
   }
   ++counters_.frames_processed;
+  gate_.taken(frame.utime);
   maybe_publish(frame.utime);
 }
 

@@ -12,6 +12,7 @@
 
 #include "semx/runtime/node.hpp"
 #include "semx/semantics/config.hpp"
+#include "semx/semantics/frame_gate.hpp"
 #include "semx/semantics/pipeline.hpp"
 #include "semx/semantics/regions.hpp"
 
@@ -19,11 +20,13 @@ namespace semx::semantics {
 
 struct SemanticsNodeCounters {
   int64_t frames_processed = 0;
+  int64_t frames_skipped = 0;     // not due (detector.frame_period_s): dropped unread
   int64_t frames_rejected = 0;    // complete, but the pipeline refused them (see last_reject)
   int64_t frames_incomplete = 0;  // parts dropped before the rest arrived
   int64_t parts_mismatched = 0;   // parts of one frame_id with different camera sizes
   int64_t bad_payload = 0;        // passed the checks but did not decompress
   int64_t regions_published = 0;
+  double process_ms = 0.0;  // wall time in the pipeline, for the exit summary only
 };
 
 class SemanticsNode {
@@ -60,6 +63,7 @@ class SemanticsNode {
   runtime::Node node_;
   SemanticPipeline pipeline_;
   RegionPublisher publisher_;
+  FrameGate gate_;
   bool need_labels_, need_rgb_;
   std::map<int64_t, Pending> pending_;
   uint64_t arrivals_ = 0;

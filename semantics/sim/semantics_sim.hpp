@@ -83,8 +83,9 @@ struct RegionMatch {
 struct AccuracyReport {
   std::string world;
   int frames = 0;
-  double seconds = 0;       // message time covered
-  double ms_per_frame = 0;  // semantics pipeline, wall time
+  int frames_processed = 0;  // of which processed (detector.frame_period_s)
+  double seconds = 0;        // message time covered
+  double ms_per_frame = 0;   // semantics pipeline, wall time per processed frame
   std::vector<simulator::ObjectInfo> objects;
   std::vector<double> longest_view_s;  // per object
   std::vector<RegionMatch> matches;    // one per published region

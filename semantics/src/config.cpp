@@ -56,6 +56,7 @@ void load(runtime::ConfigMap& m, SemanticsConfig& c) {
   d.get("min_area_px", c.detector.min_area_px, 1, 1 << 24);
   d.get("morph_kernel_px", c.detector.morph_kernel_px, 1, 31);
   if (c.detector.morph_kernel_px % 2 == 0) d.fail("morph_kernel_px", "must be odd");
+  d.get("frame_period_s", c.detector.frame_period_s, 0.0, 3600.0);
   auto dnn = d.child("dnn");
   load_dnn(dnn, c.detector.dnn);
   if (c.detector.type == "dnn" && c.detector.dnn.model.empty()) {

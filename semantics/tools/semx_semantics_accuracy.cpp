@@ -88,6 +88,7 @@ int main(int argc, char** argv) {
     std::printf("world: %s\n", r.world.c_str());
     std::printf("noise: %s\n", clean ? "off" : "detection + depth");
     std::printf("frames: %d frames\n", r.frames);
+    std::printf("frames_processed: %d frames\n", r.frames_processed);
     std::printf("duration: %.1f s\n", r.seconds);
     std::printf("objects_in_world: %zu objects\n", r.objects.size());
     std::printf("objects_in_view: %d objects\n", r.total.objects_in_view);

@@ -40,6 +40,7 @@ MapperConfig small_config() {
   c.esdf.window = {4.0, 4.0, 2.0};  // 40 x 40 x 20 voxels: fast, and still a real field
   c.streaming.snapshot_period = 0;  // only on request, unless a test says otherwise
   c.streaming.stats_period = 1.0;
+  c.streaming.esdf_period = 0;  // an ESDF after every frame, so each can be compared with a reference
   return c;
 }
 
@@ -370,6 +371,117 @@ TEST(MapperNode, PeriodicSnapshotsFollowMessageTime) {
   EXPECT_EQ(snaps[1].utime, 2000000);
   EXPECT_EQ(snaps[2].utime, 4000000);
   EXPECT_EQ(wire.count(ch::MAP_STATS), 0);
+}
+
+// The default streaming.esdf_period (0.2 s of message time): the first frame's ESDF at once, then
+// one with the first frame at or after each due time; the others get only their MAP_UPDATE.
+TEST(MapperNode, DefaultEsdfPeriodSendsFiveEsdfsPerSecondOfFrames) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(4, cam, 4);
+  MapperConfig cfg = small_config();
+  cfg.streaming.esdf_period = MapperConfig().streaming.esdf_period;
+  ASSERT_DOUBLE_EQ(cfg.streaming.esdf_period, 0.2);
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
+  // 30 Hz frames on the simulator's 10 ms tick grid, 0.5 s of them.
+  std::vector<int64_t> sent;
+  for (int k = 0; k <= 15; ++k) {
+    const int64_t utime = (k * 100000 / 3 + 9999) / 10000 * 10000;
+    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k % 4], utime));
+    node.drain();
+  }
+  EXPECT_EQ(wire.count(ch::MAP_UPDATE), 16);
+  std::vector<int64_t> esdf_utimes;
+  for (const auto& e : wire.all<semx::esdf_local_t>(ch::ESDF_LOCAL)) esdf_utimes.push_back(e.utime);
+  EXPECT_EQ(esdf_utimes, (std::vector<int64_t>{0, 200000, 400000}));
+  EXPECT_EQ(mn.counters().esdfs, 3);
+}
+
+// streaming.lockstep_delay (default 0.04 s): in LOCKSTEP a frame is integrated on the worker and
+// its outputs go out in the handler of the first tick 0.04 s after it, before that tick's ack;
+// they are exactly the outputs of the synchronous node. A tick with stats due publishes every
+// frame in flight first, so MAP_STATS describes the map of the last MAP_UPDATE.
+TEST(MapperNode, LockstepDelayPublishesAFramesOutputsAtAFixedLaterTick) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(4, cam, 4);
+  MapperConfig cfg = small_config();
+  cfg.streaming.stats_period = 0.15;
+  ASSERT_DOUBLE_EQ(cfg.streaming.lockstep_delay, 0.04);
+  runtime::Node node(memq_node("mapper", /*lockstep=*/true));
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  Mapper reference(cfg);
+  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
+  const std::vector<int64_t> frame_ticks = {3, 7, 10, 13};
+  std::vector<MapDelta> expected;
+  std::vector<std::vector<float>> expected_esdf;
+  node.publish(ch::SIM_CLOCK, clock_at(0, 0, true));
+  node.drain();
+  for (int64_t t = 1; t <= 20; ++t) {
+    const auto f = std::find(frame_ticks.begin(), frame_ticks.end(), t);
+    if (f != frame_ticks.end()) {
+      const auto& frame = frames[f - frame_ticks.begin()];
+      node.publish(ch::ODOMETRY, odometry_at(vehicle, t * 10000));
+      node.publish(ch::CAMERA_DEPTH, frame_message(cam, frame, t * 10000));
+      expected.push_back(
+          reference.integrate(DepthFrame::view(cam, frame.pose, frame.depth, t * 10000)).delta);
+      reference.update_esdf(vehicle);
+      expected_esdf.push_back(reference.esdf().distance);
+    }
+    node.publish(ch::SIM_CLOCK, clock_at(t, t * 10000, true));
+    node.drain();
+  }
+  EXPECT_EQ(mn.frames_in_flight(), 0u);
+  const auto updates = wire.all<semx::map_update_t>(ch::MAP_UPDATE);
+  const auto esdfs = wire.all<semx::esdf_local_t>(ch::ESDF_LOCAL);
+  ASSERT_EQ(updates.size(), 4u);
+  ASSERT_EQ(esdfs.size(), 4u);
+  // The wire position of SIM_CLOCK(k) and SIM_ACK(k).
+  auto position = [&](const std::string& channel, int64_t tick) {
+    for (size_t i = 0; i < wire.channels.size(); ++i) {
+      if (wire.channels[i] != channel) continue;
+      int64_t got = -1;
+      if (channel == ch::SIM_CLOCK) {
+        semx::clock_t c{};
+        c.decode(wire.payloads[i].data(), 0, static_cast<int>(wire.payloads[i].size()));
+        got = c.tick;
+      } else {
+        semx::ack_t a{};
+        a.decode(wire.payloads[i].data(), 0, static_cast<int>(wire.payloads[i].size()));
+        got = a.tick;
+      }
+      if (got == tick) return static_cast<int>(i);
+    }
+    return -1;
+  };
+  // Stats are due at 0.15 s (tick 15): frame 13 goes out there, early, with the stats after it.
+  const std::vector<int64_t> publish_ticks = {7, 11, 14, 15};
+  for (size_t k = 0; k < 4; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    MapDelta got;
+    ASSERT_TRUE(from_message(updates[k], got));
+    EXPECT_EQ(got.seq, expected[k].seq);
+    EXPECT_EQ(got.utime, frame_ticks[k] * 10000);
+    ASSERT_EQ(got.changes.size(), expected[k].changes.size());
+    for (size_t i = 0; i < got.changes.size(); ++i) {
+      ASSERT_EQ(got.changes[i].key, expected[k].changes[i].key);
+      ASSERT_EQ(got.changes[i].state, expected[k].changes[i].state);
+    }
+    EXPECT_EQ(esdfs[k].utime, frame_ticks[k] * 10000);
+    EXPECT_EQ(esdfs[k].distance, expected_esdf[k]);
+    const int at = wire.index_of(ch::MAP_UPDATE, static_cast<int>(k));
+    EXPECT_GT(at, position(ch::SIM_CLOCK, publish_ticks[k]));
+    EXPECT_LT(at, position(ch::SIM_ACK, publish_ticks[k]));
+    EXPECT_LT(wire.index_of(ch::ESDF_LOCAL, static_cast<int>(k)), position(ch::SIM_ACK, publish_ticks[k]));
+  }
+  const auto stats = wire.all<semx::map_stats_t>(ch::MAP_STATS);
+  ASSERT_EQ(stats.size(), 2u) << "t = 0 and 0.15 s";
+  EXPECT_EQ(stats[1].seq, 4);
+  EXPECT_GT(wire.index_of(ch::MAP_STATS, 1), wire.index_of(ch::MAP_UPDATE, 3));
+  expect_same(mn.mapper().map().grid(), reference.map().grid());
 }
 
 // In LOCKSTEP the node's outputs for tick k are on the wire before its SIM_ACK(k), and a

@@ -124,6 +124,31 @@ TEST(Node, OversizedMessagesAreDroppedUnread) {
   EXPECT_EQ(n.counters().malformed, 0);
 }
 
+TEST(Node, SkipFilterDropsByUtimeBeforeDecoding) {
+  Node n(memq("t"));
+  std::vector<int64_t> delivered;
+  n.subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t& m) { delivered.push_back(m.utime); });
+  std::vector<int64_t> asked;
+  n.skip_unless("ODOMETRY", [&](int64_t utime) {
+    asked.push_back(utime);
+    return utime % 2 == 0;
+  });
+  for (int64_t t : {2, 3, 4, -5}) {
+    auto m = odom(1.0);
+    m.utime = t;
+    n.publish("ODOMETRY", m);
+  }
+  const uint8_t garbage[12] = {1, 2, 3};  // too short to hold a utime: the normal checks apply
+  n.publish_raw("ODOMETRY", garbage, sizeof garbage);
+  drain(n);
+  EXPECT_EQ(asked, (std::vector<int64_t>{2, 3, 4, -5}));
+  EXPECT_EQ(delivered, (std::vector<int64_t>{2, 4}));
+  const ChannelCounters& c = n.incoming().at("ODOMETRY");
+  EXPECT_EQ(c.messages, 5);
+  EXPECT_EQ(c.skipped, 2);
+  EXPECT_EQ(c.malformed, 1);
+}
+
 TEST(Node, HandlerExceptionsAreCaughtAndCounted) {
   Node n(memq("t"));
   n.subscribe<semx::odometry_t>("ODOMETRY", [](const semx::odometry_t&) { throw std::runtime_error("bug"); });

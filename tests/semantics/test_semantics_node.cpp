@@ -28,15 +28,15 @@ semx::runtime::NodeOptions memq() {
 }
 
 struct Harness {
-  SemanticsNode sn{memq(), SemanticsConfig{}};
+  explicit Harness(const SemanticsConfig& config = SemanticsConfig{}) : sn(memq(), config) {
+    sn.node().subscribe<semx::semantic_regions_t>(
+        ch::SEMANTIC_REGIONS, [this](const semx::semantic_regions_t& m) { published.push_back(m); });
+  }
+  SemanticsNode sn;
   Scene scene{room({Solid::box(SemanticClass::kChair, {4.0, 2.5, 0.45}, {0.45, 0.45, 0.9})})};
   std::vector<semx::semantic_regions_t> published;
   int64_t frame = 0, tick = 0, utime = 0;
 
-  Harness() {
-    sn.node().subscribe<semx::semantic_regions_t>(
-        ch::SEMANTIC_REGIONS, [this](const semx::semantic_regions_t& m) { published.push_back(m); });
-  }
   template <class T>
   void send(const char* channel, const T& m) {
     sn.node().publish(channel, m);
@@ -74,7 +74,12 @@ struct Harness {
 TEST(SemanticsNode, FramesInRegionsOut) {
   Harness h;
   for (int k = 0; k < 30; ++k) h.step(k % 2 == 1);
-  EXPECT_EQ(h.sn.counters().frames_processed, 30);
+  // 30 Hz frames, detector.frame_period_s = 0.1: every third capture, the others unread.
+  EXPECT_EQ(h.sn.counters().frames_processed, 10);
+  EXPECT_EQ(h.sn.counters().frames_skipped, 20);
+  EXPECT_EQ(h.sn.node().incoming().at(ch::CAMERA_DEPTH).skipped, 20);
+  EXPECT_EQ(h.sn.node().incoming().at(ch::CAMERA_LABELS).skipped, 20);
+  EXPECT_EQ(h.sn.node().incoming().at(ch::CAMERA_DEPTH).malformed, 0);
   ASSERT_FALSE(h.published.empty());
   const auto& last = h.published.back();
   ASSERT_EQ(last.num_regions, 1);
@@ -158,10 +163,21 @@ TEST(SemanticsNode, MalformedCameraMessagesAreCountedAndDropped) {
 
   // The node is still fine.
   for (int k = 0; k < 30; ++k) h.step();
-  EXPECT_EQ(h.sn.counters().frames_processed, 30);
+  EXPECT_EQ(h.sn.counters().frames_processed, 10);
   ASSERT_FALSE(h.published.empty());
   EXPECT_EQ(h.published.back().num_regions, 1);
   EXPECT_EQ(h.sn.node().counters().handler_errors, 0);
+}
+
+TEST(SemanticsNode, FramePeriodZeroProcessesEveryFrame) {
+  SemanticsConfig c;
+  c.detector.frame_period_s = 0;
+  Harness h(c);
+  for (int k = 0; k < 30; ++k) h.step(k % 2 == 1);
+  EXPECT_EQ(h.sn.counters().frames_processed, 30);
+  EXPECT_EQ(h.sn.counters().frames_skipped, 0);
+  ASSERT_FALSE(h.published.empty());
+  EXPECT_EQ(h.published.back().num_regions, 1);
 }
 
 TEST(SemanticsNode, LonePartsNeverMakeAFrameAndDoNotPileUp) {

@@ -5,7 +5,7 @@
 //   occupancy:   { prob_hit, prob_miss, clamp_min, clamp_max, threshold, bounds_min, bounds_max }
 //   integration: { min_range, max_range, pixel_step, mode }
 //   esdf:        { enabled, window, max_distance, unknown_as_occupied }
-//   streaming:   { snapshot_period, stats_period, esdf_period }
+//   streaming:   { snapshot_period, stats_period, esdf_period, lockstep_delay }
 //   checkpoint:  { path, period }
 #pragma once
 
@@ -58,7 +58,17 @@ struct EsdfParams {
 struct StreamingParams {
   double snapshot_period = 5.0;  // MAP_SNAPSHOT, besides those sent on request
   double stats_period = 1.0;     // MAP_STATS (counts frontiers over the whole map)
-  double esdf_period = 0.0;      // ESDF_LOCAL; 0 = after every integrated frame
+  // ESDF_LOCAL; 0 = after every integrated frame. 0.2 s (5 Hz) because each message is the whole
+  // window (1.2 MB at the defaults) and each recompute ~8 ms: every frame (30 Hz) made the ESDF
+  // the largest cost of a lockstep run, while the controller needs it far less often (it brakes
+  // on a 2 s horizon and calls an ESDF stale after safety.max_esdf_age = 1 s).
+  double esdf_period = 0.2;
+  // LOCKSTEP only: a frame is integrated (and its ESDF computed) on a worker thread while the
+  // simulator and the other nodes go on, and its MAP_UPDATE / ESDF_LOCAL are published by the
+  // first tick at least this long after the frame (message time, so every run publishes them at
+  // the same tick). 0 = in the frame's handler, before the ack of the frame's own tick. 0.04 s
+  // spans the next camera frame at 30 Hz, so its rendering overlaps this frame's integration.
+  double lockstep_delay = 0.04;
 };
 
 struct CheckpointParams {

@@ -48,6 +48,7 @@ struct ChannelCounters {
   int64_t malformed = 0;
   int64_t dropped = 0;
   int64_t bytes = 0;
+  int64_t skipped = 0;  // refused by a skip_unless() filter before decoding (not malformed)
 };
 
 struct NodeCounters {
@@ -88,6 +89,11 @@ class Node {
   template <class T>
   void subscribe(const std::string& channel, std::function<void(const T&)> handler,
                  std::function<bool(const T&)> accept = nullptr);
+  // Cheap early out for large messages a node only needs some of: a message on `channel` whose
+  // utime (every semx type's first field, read straight from the bytes) makes `wanted` false is
+  // counted (ChannelCounters::skipped) and dropped before it is validated or decoded. Messages
+  // too short to hold a utime go through the normal checks.
+  void skip_unless(const std::string& channel, std::function<bool(int64_t utime)> wanted);
   // Raw bytes of every channel matching `regex` (tools: monitors, recorders).
   using RawHandler = std::function<void(const std::string& channel, const uint8_t* data, std::size_t size)>;
   void subscribe_raw(const std::string& regex, RawHandler handler);
@@ -142,6 +148,7 @@ class Node {
   std::unique_ptr<lcm::LCM> lcm_;
   std::map<std::string, std::vector<std::unique_ptr<Subscription>>> subs_;
   std::vector<std::pair<std::string, RawHandler>> raw_handlers_;
+  std::map<std::string, std::function<bool(int64_t)>> skip_filters_;
   std::vector<uint8_t> encode_buffer_;
   std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;
   SimClock clock_;

@@ -34,6 +34,8 @@ struct DetectorConfig {
   bool use_instances = true;
   int min_area_px = 80;     // smaller components are dropped
   int morph_kernel_px = 3;  // square opening kernel (1 = no clean-up)
+  // At most one frame per this much message time is processed (0 = every frame); see FrameGate.
+  double frame_period_s = 0.1;
   DnnConfig dnn;
 };
 
