@@ -15,7 +15,8 @@ CollisionChecker::CollisionChecker(const CollisionConfig& config)
     : config_(config),
       body_half_(0.5 * config.vehicle_size + Eigen::Vector3d::Constant(config.margin)),
       vehicle_half_(0.5 * config.vehicle_size),
-      reach_(body_half_.cwiseMax(Eigen::Vector3d::Constant(config.clearance))) {}
+      reach_(body_half_.cwiseMax(
+          Eigen::Vector3d::Constant(std::max(config.clearance, config.passage_clearance)))) {}
 
 bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double radius,
                                    bool unknown_is_occupied) const {
@@ -80,16 +81,21 @@ bool CollisionChecker::node_free(const Eigen::Vector3d& p) const {
   return region_free(p, body_half_, config_.clearance, true);
 }
 
+bool CollisionChecker::passage_free(const Eigen::Vector3d& p) const {
+  return region_free(p, body_half_, config_.passage_clearance, true);
+}
+
 bool CollisionChecker::vehicle_free(const Eigen::Vector3d& p) const {
   return region_free(p, vehicle_half_, 0.0, false);
 }
 
-bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_step) const {
+bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_step, bool passage) const {
   if (!grid_ || !p.allFinite()) return false;
   const double res = grid_->resolution(), inv = 1.0 / res;
-  const double r = config_.clearance;
+  const double r = passage ? config_.passage_clearance : config_.clearance;
+  auto ok = [&](const Eigen::Vector3d& q) { return passage ? passage_free(q) : node_free(q); };
   for (int it = 0; it < iterations; ++it) {
-    if (node_free(p)) return true;
+    if (ok(p)) return true;
     ++box_checks_;
     VoxelKey kmin, kmax;
     for (int i = 0; i < 3; ++i) {
@@ -113,7 +119,7 @@ bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_ste
     if (n < 1e-9) return false;  // inside an obstacle or pushed equally from all sides
     p += push * std::min(1.0, max_step / n);
   }
-  return node_free(p);
+  return ok(p);
 }
 
 bool CollisionChecker::centre_line_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -143,7 +149,7 @@ bool CollisionChecker::samples_free(const Eigen::Vector3d& a, const Eigen::Vecto
       const double t = static_cast<double>(i) / n;
       const Eigen::Vector3d p = a + t * (b - a);
       const bool near_root = escape_radius > 0 && t * length < escape_radius;
-      const bool ok = near_root ? vehicle_free(p) : node_free(p);
+      const bool ok = near_root ? vehicle_free(p) : passage_free(p);
       if (!ok) return false;
     }
   }

@@ -107,7 +107,8 @@ void DepStrategy::process_map_changes(PlanContext& ctx) {
   for (int64_t id : recheck) {
     if (!graph_.alive(id)) continue;
     const Eigen::Vector3d a = graph_.node(id).position;
-    if (id != root_ && (everything || obstacle_near(a, a, reach, res)) && !checker_.node_free(a)) {
+    const bool node_ok = graph_.node(id).passage ? checker_.passage_free(a) : checker_.node_free(a);
+    if (id != root_ && (everything || obstacle_near(a, a, reach, res)) && !node_ok) {
       graph_.remove_node(id);
       ++ctx.counters->nodes_pruned;
       continue;
@@ -176,9 +177,17 @@ int64_t DepStrategy::insert_root(PlanContext& ctx) {
 int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   Stopwatch sample_watch;
   // A draw too close to a wall is moved away from it (centred in a doorway) rather than dropped.
+  // Where even the middle is too narrow for a node (a doorway mapped 0.9 m wide), the draw is
+  // centred again with the passage clearance and kept as a passage node: a waypoint edges can
+  // cross the doorway through, which the vehicle never stops at.
   Eigen::Vector3d p = draw;
-  const bool ok = checker_.centre(p) && ctx.grid->state(p) == VoxelState::kFree &&
-                  !graph_.any_within(p, config_.sampling.min_node_distance);
+  bool passage = false;
+  bool ok = checker_.centre(p);
+  if (!ok && config_.collision.passage_clearance < config_.collision.clearance) {
+    p = draw;
+    ok = passage = checker_.centre(p, 3, 0.3, true);
+  }
+  ok = ok && ctx.grid->state(p) == VoxelState::kFree && !graph_.any_within(p, config_.sampling.min_node_distance);
   ctx.counters->sample_ms += sample_watch.ms();
   if (!ok) return -1;
   Stopwatch connect_watch;
@@ -192,6 +201,7 @@ int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   int64_t id = -1;
   if (!links.empty()) {
     id = graph_.add_node(p);
+    graph_.node(id).passage = passage;
     for (const auto& [to, length] : links) {
       graph_.add_edge(id, to, length);
       ++ctx.counters->edges_added;
@@ -200,6 +210,50 @@ int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   }
   ctx.counters->connect_ms += connect_watch.ms();
   return id;
+}
+
+void DepStrategy::bridge(PlanContext& ctx) {
+  // Parts of the roadmap the root cannot reach (a room whose nodes came from frontier draws seen
+  // through its doorway, or one the vehicle left after the doorway's edges were pruned) are
+  // joined through the narrow passage between them: candidates on the segment from an
+  // unreachable node to the nearest reachable one, centred (as passage nodes where needed). A
+  // doorway is a target of ~0.1 m across that uniform draws hit about once a minute; along the
+  // segment every draw is near the line through the doorway.
+  const int attempts = config_.sampling.bridge_attempts;
+  if (attempts <= 0 || !graph_.alive(root_)) return;
+  const Roadmap::Search reach = graph_.shortest_paths(root_);
+  ctx.counters->search_settled += reach.settled;
+  // Targets: unreachable nodes and frontier clusters (a node drawn beyond a narrow passage is
+  // kept only when it connects to a node within max_edge_length, so the first one past the
+  // passage has to come from a draw near the line through it).
+  std::vector<Eigen::Vector3d> targets;
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (n.alive && !reach.reached(n.id)) targets.push_back(n.position);
+  }
+  if (ctx.frontiers) {
+    for (const FrontierTracker::Cluster& c : ctx.frontiers->clusters(config_.sampling.min_cluster_voxels))
+      targets.push_back(c.centre);
+  }
+  if (targets.empty()) return;
+  const double radius = 2.0 * config_.roadmap.max_edge_length;
+  for (int i = 0; i < attempts; ++i) {
+    const Eigen::Vector3d q = targets[static_cast<size_t>(ctx.rng->below(targets.size()))];
+    int64_t a = -1;
+    for (int64_t id : graph_.nearest(q, -1, radius)) {
+      if (static_cast<size_t>(id) < reach.distance.size() && reach.reached(id)) {
+        a = id;
+        break;
+      }
+    }
+    if (a < 0) continue;
+    const Eigen::Vector3d p = graph_.node(a).position;
+    const double t = ctx.rng->uniform(0.2, 0.8), j = 0.15;
+    const Eigen::Vector3d draw = p + t * (q - p) + Eigen::Vector3d(ctx.rng->uniform(-j, j), ctx.rng->uniform(-j, j),
+                                                                   ctx.rng->uniform(-j, j));
+    ++ctx.counters->samples_drawn;
+    if (ctx.grid->state(draw) != VoxelState::kFree) continue;
+    try_insert(ctx, draw);
+  }
 }
 
 void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
@@ -255,7 +309,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     cost_[static_cast<size_t>(n.id)] =
         travel_time(search_.distance[static_cast<size_t>(n.id)], ctx.pose.yaw, m.gain.yaw, config_.cost);
     score_[static_cast<size_t>(n.id)] = score_of(ctx, score, n.id);
-    if (m.blacklisted_until >= ctx.cycle) continue;
+    if (m.blacklisted_until >= ctx.cycle || m.passage) continue;
     if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id)) continue;
     queue.emplace(score_[static_cast<size_t>(n.id)], -n.id);
   }
@@ -332,6 +386,7 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
     ++checked;
     if (try_insert(ctx, p) >= 0) ++kept;
   }
+  bridge(ctx);
 
   PlanOutcome out;
   out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative);

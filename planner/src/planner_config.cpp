@@ -55,11 +55,15 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   get_vec3(co, "vehicle_size", c.collision.vehicle_size, 0.01, 10.0);
   co.get("margin", c.collision.margin, 0.0, 5.0);
   co.get("clearance", c.collision.clearance, 0.0, 5.0);
+  co.get("passage_clearance", c.collision.passage_clearance, 0.0, 5.0);
+  if (c.collision.passage_clearance > c.collision.clearance)
+    co.fail("passage_clearance", "must not exceed clearance (passage points are where nodes fit too)");
   co.get("edge_step", c.collision.edge_step, 0.005, 1.0);
   co.get("root_escape_radius", c.collision.root_escape_radius, 0.0, 5.0);
 
   auto s = m.child("sampling");
   s.get("samples", c.sampling.samples, 1, 100000);
+  s.get("bridge_attempts", c.sampling.bridge_attempts, 0, 100000);
   s.get("max_attempts_factor", c.sampling.max_attempts_factor, 1, 1000);
   s.get("max_draws_factor", c.sampling.max_draws_factor, 1, 100000);
   s.get("local_radius", c.sampling.local_radius, 0.1, 100.0);

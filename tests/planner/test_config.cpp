@@ -21,9 +21,11 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(collision.vehicle_size);
   SAME(collision.margin);
   SAME(collision.clearance);
+  SAME(collision.passage_clearance);
   SAME(collision.edge_step);
   SAME(collision.root_escape_radius);
   SAME(sampling.samples);
+  SAME(sampling.bridge_attempts);
   SAME(sampling.max_attempts_factor);
   SAME(sampling.max_draws_factor);
   SAME(sampling.local_radius);
@@ -90,8 +92,10 @@ TEST(PlannerConfig, DefaultsMatchThePaperAndTheController) {
   EXPECT_EQ(d.gain.yaw_bins, 32);
   EXPECT_NEAR(d.gain.horizontal_fov(), 3.14159265358979 / 2, 1e-12);
   EXPECT_NEAR(d.gain.vertical_fov(), 2 * std::atan(0.75), 1e-12);
-  // Edges keep the controller's 0.4 m.
-  EXPECT_GE(d.collision.clearance - d.collision.edge_step / 2, 0.4 - 1e-12);
+  // Edges keep the controller's 0.4 m in ESDF distance (to voxel centres: the distance to the
+  // cube plus at least half a voxel, 0.05 m).
+  EXPECT_GE(d.collision.passage_clearance - d.collision.edge_step / 2 + 0.05, 0.4 - 1e-12);
+  EXPECT_LE(d.collision.passage_clearance, d.collision.clearance);
   EXPECT_EQ(d.kind(), PlannerKind::kSemanticDep);
 }
 

@@ -6,9 +6,12 @@
 //                    (0.35 × 0.35 × 0.25 m half sizes by default) nor comes within `clearance`
 //                    (0.45 m, Euclidean, to the voxel's cube) of p: the box is the body, the ball
 //                    the controller's distance bound plus 5 cm;
-//   edge_free(a, b): the same test at points of the segment at most edge_step apart (a and b are
+//   passage_free(p): the same with `passage_clearance` (0.40 m): where the vehicle may pass
+//                    without stopping (edge samples, passage nodes in doorways);
+//   edge_free(a, b): passage_free at points of the segment at most edge_step apart (a and b are
 //                    nodes, checked already). Every point of the segment is within edge_step/2
-//                    of a checked point, so it keeps clearance - edge_step/2 (0.40 m);
+//                    of a checked point, so it keeps passage_clearance - edge_step/2 (0.35 m to
+//                    the cube, >= 0.40 m to the voxel centres the ESDF measures);
 //   root_edge_free(root, b): edge_free when the root itself is node_free; otherwise points within
 //                    root_escape_radius of the root are checked with the bare vehicle box against
 //                    occupied voxels only: the vehicle may leave a pose whose surroundings are not
@@ -38,15 +41,17 @@ class CollisionChecker {
   const Eigen::Vector3d& half_extent() const { return reach_; }
 
   bool node_free(const Eigen::Vector3d& p) const;
+  bool passage_free(const Eigen::Vector3d& p) const;
   bool edge_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   bool root_edge_free(const Eigen::Vector3d& root, const Eigen::Vector3d& b) const;
   // The bare vehicle box at p overlaps no occupied voxel (unknown allowed).
   bool vehicle_free(const Eigen::Vector3d& p) const;
   // Moves p away from the occupied and unknown voxels within `clearance` of it (each pushes by
   // how much it intrudes, along the line from its cube's nearest point), up to `iterations` times
-  // and by at most max_step each; true when p ends node_free. Centres a draw that fell too close
-  // to a wall, and in a doorway between both jambs, so narrow passages get nodes and edges.
-  bool centre(Eigen::Vector3d& p, int iterations = 3, double max_step = 0.3) const;
+  // and by at most max_step each; true when p ends node_free (passage_free with `passage`).
+  // Centres a draw that fell too close to a wall, and in a doorway between both jambs, so narrow
+  // passages get nodes and edges.
+  bool centre(Eigen::Vector3d& p, int iterations = 3, double max_step = 0.3, bool passage = false) const;
 
   // Box checks made so far (for the planning-time charge); reset by the caller.
   int64_t box_checks() const { return box_checks_; }

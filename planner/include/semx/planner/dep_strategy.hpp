@@ -55,6 +55,9 @@ class DepStrategy : public Strategy {
   int64_t insert_root(PlanContext& ctx);
   // Step 3 for one position: the new node's id, or -1 when it was not kept.
   int64_t try_insert(PlanContext& ctx, const Eigen::Vector3d& p);
+  // Candidates between parts of the roadmap the root cannot reach and the nearest reachable
+  // nodes (sampling.bridge_attempts per cycle).
+  void bridge(PlanContext& ctx);
   // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
   using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
   // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach.

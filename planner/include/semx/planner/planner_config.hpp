@@ -32,8 +32,14 @@ struct CollisionConfig {
   // m: Euclidean distance every node keeps from occupied and unknown voxels (to their cubes). The
   // controller rejects waypoints closer than 0.4 m (ESDF, unknown counts as occupied), so 0.45.
   double clearance = 0.45;
+  // m: the same distance for the points the vehicle only passes through: edge samples and
+  // passage nodes (nodes in a gap too narrow for `clearance`, never goals). A doorway of 0.9-1.0 m
+  // is mapped 0.8-1.0 m wide (jamb faces on voxel boundaries land on either side), which leaves
+  // at most 0.40-0.50 m to the nearest cube: with 0.45 no edge crossed most of env3's doorways.
+  // 0.40 to the cube is >= 0.45 to the voxel centres the ESDF measures (the controller: >= 0.40).
+  double passage_clearance = 0.40;
   // m: edges are checked at points at most this far apart; every point between keeps
-  // clearance - edge_step / 2 (0.40 m).
+  // passage_clearance - edge_step / 2 (0.35 m to cubes, >= 0.40 to voxel centres).
   double edge_step = 0.1;
   // m: near the vehicle an edge from the root is checked only against occupied voxels and the
   // bare vehicle box, so the vehicle can leave a pose whose surroundings are not mapped yet.
@@ -43,6 +49,9 @@ struct CollisionConfig {
 // Where candidate nodes are drawn.
 struct SamplingConfig {
   int samples = 45;                // candidates kept per cycle at most: the paper's sampling density
+  // Candidates per cycle drawn between unreachable roadmap parts and the reachable one (through
+  // the doorway between them; DepStrategy::bridge); 0 disables.
+  int bridge_attempts = 20;
   int max_attempts_factor = 4;     // candidates collision-checked per cycle at most samples × this
   int max_draws_factor = 25;       // draws at most samples × max_attempts_factor × this (a draw whose
                                    // voxel is not free is dropped before any check)

@@ -30,6 +30,10 @@ struct RoadmapNode {
   bool gain_stale = true;          // map changed within sensor range since the evaluation
   int64_t gain_cycle = -1;         // cycle of the last evaluation
   int64_t blacklisted_until = -1;  // cycle until which it is not a goal (controller rejected it)
+  // Only passage_free (a doorway narrower than the node clearance allows): a waypoint, never a
+  // goal (the vehicle would hover where one voxel of map noise puts it below the controller's
+  // bound).
+  bool passage = false;
 };
 
 class Roadmap {

@@ -1,0 +1,175 @@
+// semx-planner-probe: what the planner's collision checks say about doorways on a real map (a
+// mapper checkpoint, e.g. from semx-map-replay or semx-mapper --checkpoint). For each doorway it
+// prints horizontal slices of the voxel states with the points where a roadmap node may stand,
+// and how many straight edges through the doorway pass the edge check. Debugging aid for
+// "the roadmap never connects this room" (docs/planner.md, "Narrow passages").
+//
+//   semx-planner-probe MAP.ckpt [--door X,Y,AXIS]... [--set KEY=VALUE]...
+//
+// AXIS is the axis the wall runs along (x: a wall of constant y, crossed along y). Without
+// --door, env3's doorways.
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "semx/mapper/checkpoint.hpp"
+#include "semx/mapper/occupancy_map.hpp"
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/planner_config.hpp"
+#include "semx/runtime/args.hpp"
+#include "semx/runtime/config.hpp"
+
+using namespace semx;
+
+namespace {
+
+struct Door {
+  double x, y;
+  char axis;  // 'x': the wall runs along x (constant y), the doorway is crossed along y
+};
+
+Eigen::Vector3d at(const Door& d, double along, double across, double z) {
+  return d.axis == 'x' ? Eigen::Vector3d(d.x + along, d.y + across, z)
+                       : Eigen::Vector3d(d.x + across, d.y + along, z);
+}
+
+void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& checker, const Door& d) {
+  const double res = grid.resolution();
+  std::printf("== doorway (%.2f, %.2f) wall along %c\n", d.x, d.y, d.axis);
+  for (double z : {0.75, 1.05, 1.35, 1.65}) {
+    std::printf(" z=%.2f   rows: across (wall normal) -1.0..+1.0; columns: along -0.9..+0.9\n", z);
+    for (double across = -1.0 + 0.5 * res; across < 1.0; across += res) {
+      std::string row = "  ";
+      for (double along = -0.9 + 0.5 * res; along < 0.9; along += res) {
+        const Eigen::Vector3d p = at(d, along, across, z);
+        const mapper::VoxelState s = grid.state(p);
+        char c = s == mapper::VoxelState::kOccupied ? '#' : s == mapper::VoxelState::kUnknown ? '?' : '.';
+        if (c == '.' && checker.node_free(p)) c = '+';
+        row += c;
+      }
+      std::printf("%s\n", row.c_str());
+    }
+  }
+  // The gap in the wall plane: per height, the widest free opening, and the largest distance from
+  // a point of the doorway plane to the nearest occupied voxel centre (what the ESDF measures)
+  // and to the nearest occupied-or-unknown voxel cube (what the planner measures).
+  for (double z = 0.55; z < 1.8; z += 0.2) {
+    double best_esdf = 0, best_cube = 0;
+    for (double along = -0.6; along <= 0.6; along += 0.01) {
+      const Eigen::Vector3d q = at(d, along, 0.0, z);
+      const mapper::VoxelKey k = grid.keys().key(q);
+      double esdf = 1e9, cube = 1e9;
+      for (int dz = -8; dz <= 8; ++dz)
+        for (int dy = -8; dy <= 8; ++dy)
+          for (int dx = -8; dx <= 8; ++dx) {
+            const mapper::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
+            const mapper::VoxelState s = grid.state(v);
+            if (s == mapper::VoxelState::kFree) continue;
+            const Eigen::Vector3d lo(v.x * res, v.y * res, v.z * res);
+            const Eigen::Vector3d c = q.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
+            cube = std::min(cube, (q - c).norm());
+            if (s == mapper::VoxelState::kOccupied)
+              esdf = std::min(esdf, (q - lo - Eigen::Vector3d::Constant(0.5 * res)).norm());
+          }
+      best_esdf = std::max(best_esdf, esdf);
+      best_cube = std::max(best_cube, cube);
+    }
+    std::printf("  z %.2f: max centre distance to occupied %.3f, max cube distance to non-free %.3f\n", z,
+                best_esdf, best_cube);
+  }
+  // Straight crossings: node-free points in the doorway plane, and edges 1.2 m to either side.
+  int node_ok = 0, edge_ok = 0, vehicle_ok = 0, tried = 0;
+  double best_along = 0, best_z = 0;
+  for (double z = 0.4; z <= 1.8; z += 0.05) {
+    for (double along = -0.6; along <= 0.6; along += 0.02) {
+      ++tried;
+      const Eigen::Vector3d p = at(d, along, 0.0, z);
+      vehicle_ok += checker.vehicle_free(p);
+      if (checker.node_free(p)) ++node_ok;
+      if (checker.edge_free(at(d, along, -0.8, z), at(d, along, 0.8, z))) {
+        if (edge_ok == 0) best_along = along, best_z = z;
+        ++edge_ok;
+      }
+    }
+  }
+  std::printf(" crossings tried %d: vehicle box free %d, node_free in the plane %d, edge_free %d", tried,
+              vehicle_ok, node_ok, edge_ok);
+  if (edge_ok) std::printf(" (first at along %.2f z %.2f)", best_along, best_z);
+  std::printf("\n");
+  // Why the straight edge through the middle of the free gap fails: the first failing sample and
+  // the voxels that block it.
+  for (double z : {1.0, 1.3}) {
+    for (double along : {-0.05, 0.0, 0.05, 0.1}) {
+      const Eigen::Vector3d a = at(d, along, -0.8, z), b = at(d, along, 0.8, z);
+      if (checker.edge_free(a, b)) {
+        std::printf("  edge along %.2f z %.2f: free\n", along, z);
+        continue;
+      }
+      for (double t = 0; t <= 1.0; t += 0.01) {
+        const Eigen::Vector3d q = a + t * (b - a);
+        if (checker.node_free(q)) continue;
+        std::printf("  edge along %.2f z %.2f: first blocked at (%.2f %.2f %.2f) by", along, z, q.x(), q.y(),
+                    q.z());
+        const mapper::KeyMath& km = grid.keys();
+        const mapper::VoxelKey k = km.key(q);
+        double best = 1e9;
+        for (int dz = -6; dz <= 6; ++dz)
+          for (int dy = -6; dy <= 6; ++dy)
+            for (int dx = -6; dx <= 6; ++dx) {
+              const mapper::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
+              const mapper::VoxelState s = grid.state(v);
+              if (s == mapper::VoxelState::kFree) continue;
+              const Eigen::Vector3d lo(v.x * res, v.y * res, v.z * res);
+              const Eigen::Vector3d c = q.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
+              const double dist = (q - c).norm();
+              best = std::min(best, dist);
+              if (dist < 0.40)
+                std::printf(" %s(%.2f %.2f %.2f d%.2f)", s == mapper::VoxelState::kOccupied ? "occ" : "unk",
+                            lo.x() + 0.05, lo.y() + 0.05, lo.z() + 0.05, dist);
+            }
+        std::printf("\n");
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runtime::run_main("semx-planner-probe", [&] {
+    std::string ckpt, config_file;
+    std::vector<std::string> doors, overrides;
+    runtime::ArgParser p("semx-planner-probe",
+                         "Prints the planner's collision checks around doorways of a mapper checkpoint.");
+    p.positional("MAP", "mapper checkpoint (map.ckpt)", &ckpt)
+        .option("config", "FILE", "planner YAML", &config_file)
+        .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
+        .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors);
+    if (!p.parse(argc, argv)) return 0;
+    const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
+    mapper::OccupancyMap map{mapper::OccupancyParams()};
+    mapper::load_checkpoint(ckpt, map);
+    planner::CollisionChecker checker(config.collision);
+    checker.set_grid(&map.grid());
+    std::vector<Door> list;
+    for (const std::string& s : doors) {
+      Door d{};
+      std::istringstream in(s);
+      char c1, c2;
+      if (!(in >> d.x >> c1 >> d.y >> c2 >> d.axis)) {
+        std::cerr << "bad --door " << s << "\n";
+        return 2;
+      }
+      list.push_back(d);
+    }
+    if (list.empty()) {
+      list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'},  {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
+              {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'},  {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};
+    }
+    for (const Door& d : list) probe(map.grid(), checker, d);
+    return 0;
+  });
+}
