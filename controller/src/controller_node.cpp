@@ -1,6 +1,7 @@
 #include "semx/controller/controller_node.hpp"
 
 #include <cmath>
+#include <iostream>
 #include <memory>
 
 #include "semx/controller/message_adapter.hpp"
@@ -47,7 +48,17 @@ void ControllerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   if (out.status_changed || last_status_utime_ < 0 || utime - last_status_utime_ >= status_period - 1) {
     publish_status(out.status, utime);
   }
-  if (out.status_changed) update_node_state();
+  if (out.status_changed) {
+    update_node_state();
+    // Rejections and brakes in the log (RUN/logs/controller.log): the only place their reason is
+    // readable after a run, and the first thing to look at when the vehicle stops moving. Rare
+    // events (one per path at most), so they are logged even with --quiet, which is about drops.
+    const ControllerState st = out.status.state;
+    if (st == ControllerState::kRejected || st == ControllerState::kBraking) {
+      std::cerr << "semx-controller: t=" << static_cast<double>(utime) * 1e-6 << " s " << to_string(st) << " "
+                << out.status.reason << std::endl;
+    }
+  }
 }
 
 void ControllerNode::publish_status(const ControllerStatus& s, int64_t utime) {

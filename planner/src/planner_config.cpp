@@ -58,6 +58,10 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   co.get("passage_clearance", c.collision.passage_clearance, 0.0, 5.0);
   if (c.collision.passage_clearance > c.collision.clearance)
     co.fail("passage_clearance", "must not exceed clearance (passage points are where nodes fit too)");
+  co.get("door_clearance", c.collision.door_clearance, 0.0, 5.0);
+  if (c.collision.door_clearance > c.collision.passage_clearance)
+    co.fail("door_clearance", "must not exceed passage_clearance");
+  co.get("door_length", c.collision.door_length, 0.0, 100.0);
   co.get("edge_step", c.collision.edge_step, 0.005, 1.0);
   co.get("root_escape_radius", c.collision.root_escape_radius, 0.0, 5.0);
 

@@ -277,8 +277,13 @@ TEST(TrajectoryGeneration, AVehicleTooCloseToAWallMayOnlyEscape) {
   const std::vector<Box> wall{{Eigen::Vector3d(-1.0, -3, 0), Eigen::Vector3d(-0.35, 3, 3)}};
   const GridDistanceField field =
       rasterize_boxes(wall, Eigen::Vector3d(-2, -4, 0), 0.1, 80, 80, 30, 2.0, OutsideWindow::kFree);
-  const Eigen::Vector3d start(0.0, 0.0, 1.0);  // 0.35 m from the wall: below the 0.4 m bound
+  // A start between the hard bound (half_size, plus the check's pad) and the bound.
+  const double hard = cfg.clearance.half_size + 0.5 * field.lipschitz() * cfg.clearance.check_spacing;
+  Eigen::Vector3d start(0.0, 0.0, 1.0);
+  const double mid = 0.5 * (hard + cfg.clearance.bound());
+  while (field.distance(start) >= mid && start.x() > -0.3) start.x() -= 0.001;
   ASSERT_LT(field.distance(start), cfg.clearance.bound());
+  ASSERT_GT(field.distance(start), hard);
   {
     const TrajectoryGenerator gen(cfg);
     const std::vector<Eigen::Vector3d> away{start, {3, 0, 1}};
@@ -287,7 +292,7 @@ TEST(TrajectoryGeneration, AVehicleTooCloseToAWallMayOnlyEscape) {
     EXPECT_TRUE(r.clearance.escaping);
     EXPECT_GE(sample_all(r.trajectory, &field).min_distance, field.distance(start) - 0.011);
     // Along the wall it would not get out: refused.
-    const std::vector<Eigen::Vector3d> along{start, {0, 3, 1}};
+    const std::vector<Eigen::Vector3d> along{start, {start.x(), 3, 1}};
     EXPECT_FALSE(gen.generate(along, {0, 0}, at_rest(start), 0.0, field).ok);
   }
   cfg.clearance.allow_escape = false;

@@ -92,9 +92,13 @@ TEST(PlannerConfig, DefaultsMatchThePaperAndTheController) {
   EXPECT_EQ(d.gain.yaw_bins, 32);
   EXPECT_NEAR(d.gain.horizontal_fov(), 3.14159265358979 / 2, 1e-12);
   EXPECT_NEAR(d.gain.vertical_fov(), 2 * std::atan(0.75), 1e-12);
-  // Edges keep the controller's 0.4 m in ESDF distance (to voxel centres: the distance to the
-  // cube plus at least half a voxel, 0.05 m).
-  EXPECT_GE(d.collision.passage_clearance - d.collision.edge_step / 2 + 0.05, 0.4 - 1e-12);
+  // Every edge point keeps the controller's bound (half_size 0.25 + margin 0.07) plus the pad of
+  // its dense check (half a 0.02 m step times the field's Lipschitz bound, sqrt(3)), in the same
+  // ESDF units, in doorways; elsewhere the body's half diagonal (0.354 m) plus that pad
+  // (test_clearance_consistency.cpp checks it against the real field).
+  EXPECT_GE(d.collision.door_clearance, 0.32 + 0.5 * std::sqrt(3.0) * 0.02 - 1e-12);
+  EXPECT_GE(d.collision.passage_clearance, 0.354 + 0.5 * std::sqrt(3.0) * 0.02);
+  EXPECT_LE(d.collision.door_clearance, d.collision.passage_clearance);
   EXPECT_LE(d.collision.passage_clearance, d.collision.clearance);
   EXPECT_EQ(d.kind(), PlannerKind::kSemanticDep);
 }

@@ -1,23 +1,21 @@
-// Collision checks of roadmap nodes and edges against the map, with the clearance the
-// controller needs (docs/controller.md, "For the planner": waypoints ≥ 0.4 m, in ESDF distance,
-// from occupied and unknown space).
+// Collision checks of roadmap nodes and edges against the map, in the controller's own measure
+// of clearance (docs/planner.md, "Collisions and the controller's contract"): esdf(p) is the ESDF
+// value the controller would read at p (voxel-centre distances minus half a voxel, trilinear),
+// with unknown voxels counted as obstacles.
 //
-//   node_free(p):    no occupied and no unknown voxel overlaps the vehicle box grown by `margin`
-//                    (0.35 × 0.35 × 0.25 m half sizes by default) nor comes within `clearance`
-//                    (0.45 m, Euclidean, to the voxel's cube) of p: the box is the body, the ball
-//                    the controller's distance bound plus 5 cm;
-//   passage_free(p): the same with `passage_clearance` (0.40 m): where the vehicle may pass
-//                    without stopping (edge samples, passage nodes in doorways);
-//   edge_free(a, b): passage_free at points of the segment at most edge_step apart (a and b are
-//                    nodes, checked already). Every point of the segment is within edge_step/2
-//                    of a checked point, so it keeps passage_clearance - edge_step/2 (0.35 m to
-//                    the cube, >= 0.40 m to the voxel centres the ESDF measures);
+//   node_free(p):    no occupied or unknown voxel overlaps the vehicle box grown by `margin`
+//                    (0.35 × 0.35 × 0.25 m half sizes) and esdf(p) >= `clearance` (0.45 m);
+//   passage_free(p): a passage node in a doorway: the bare body box is free and esdf(p) >=
+//                    `door_clearance` (0.34 m);
+//   edge_free(a, b): every point of the segment (not only samples) keeps `passage_clearance`
+//                    (0.42 m), except at most `door_length` (1 m) that keeps door_clearance to
+//                    occupied voxels and kDoorUnknownClearance to unknown ones: what the
+//                    controller's dense check requires (0.32 m + 0.017 m pad) holds all along;
 //   root_edge_free(root, b): edge_free when the root itself is node_free; otherwise points within
 //                    root_escape_radius of the root are checked with the bare vehicle box against
 //                    occupied voxels only: the vehicle may leave a pose whose surroundings are not
-//                    mapped yet (the camera never sees the cone above and below itself: 0.6 m deep
-//                    for a ±37° vertical field of view and a 0.45 m clearance) or that drifted
-//                    close to a wall.
+//                    mapped yet (the camera never sees the cone above and below itself) or that
+//                    drifted close to a wall.
 //
 // The centre line is first walked voxel by voxel (no occupied or unknown voxel on it), which
 // rejects edges through walls and into unknown space for the price of one ray.
@@ -46,6 +44,16 @@ class CollisionChecker {
   bool root_edge_free(const Eigen::Vector3d& root, const Eigen::Vector3d& b) const;
   // The bare vehicle box at p overlaps no occupied voxel (unknown allowed).
   bool vehicle_free(const Eigen::Vector3d& p) const;
+  // The controller's ESDF value at p as it would read it on this map with unknown voxels counted
+  // as obstacles (the mapper's definition: centre-to-centre distance to the nearest obstacle voxel
+  // minus half a voxel, at voxel centres; trilinear between them). Exact up to `cap`; above it a
+  // lower bound >= cap. Never more than the controller reads, whose field ignores unknown space.
+  double esdf(const Eigen::Vector3d& p, double cap, bool unknown_is_obstacle = true) const;
+  // m: spacing of the edge points checked where the coarse (edge_step) points fall short.
+  static constexpr double kFineStep = 0.01;
+  // m: in doorways, ESDF distance kept from unknown voxels (the body's half width + 5 cm; the
+  // controller does not see them, door_clearance applies to occupied ones).
+  static constexpr double kDoorUnknownClearance = 0.3;
   // Moves p away from the occupied and unknown voxels within `clearance` of it (each pushes by
   // how much it intrudes, along the line from its cube's nearest point), up to `iterations` times
   // and by at most max_step each; true when p ends node_free (passage_free with `passage`).
@@ -62,6 +70,8 @@ class CollisionChecker {
   // when radius > 0, has its cube within `radius` of p.
   bool region_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double radius,
                    bool unknown_is_occupied) const;
+  // No obstacle voxel in the box p ± half and esdf(p) >= distance.
+  bool clear(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double distance) const;
   bool centre_line_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double skip_radius) const;
   bool samples_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double escape_radius) const;
 

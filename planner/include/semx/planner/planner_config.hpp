@@ -29,17 +29,30 @@ PlannerKind parse_planner_kind(const std::string& name);
 struct CollisionConfig {
   Eigen::Vector3d vehicle_size{0.5, 0.5, 0.3};  // m, body box (x, y, z)
   double margin = 0.1;                          // m, added to each half size of the body box
-  // m: Euclidean distance every node keeps from occupied and unknown voxels (to their cubes). The
-  // controller rejects waypoints closer than 0.4 m (ESDF, unknown counts as occupied), so 0.45.
+  // m: ESDF distance every node keeps from occupied and unknown voxels, measured as the controller
+  // measures it (CollisionChecker::esdf: voxel-centre distances minus half a voxel, trilinear). A
+  // goal is where the vehicle hovers and starts its next path, so it keeps more than the
+  // controller's bound (half_size 0.25 + margin 0.07, plus its 0.017 m sampling pad).
   double clearance = 0.45;
-  // m: the same distance for the points the vehicle only passes through: edge samples and
-  // passage nodes (nodes in a gap too narrow for `clearance`, never goals). A doorway of 0.9-1.0 m
-  // is mapped 0.8-1.0 m wide (jamb faces on voxel boundaries land on either side), which leaves
-  // at most 0.40-0.50 m to the nearest cube: with 0.45 no edge crossed most of env3's doorways.
-  // 0.40 to the cube is >= 0.45 to the voxel centres the ESDF measures (the controller: >= 0.40).
-  double passage_clearance = 0.40;
-  // m: edges are checked at points at most this far apart; every point between keeps
-  // passage_clearance - edge_step / 2 (0.35 m to cubes, >= 0.40 to voxel centres).
+  // m: the same for every point the vehicle only passes through: every point of an edge (not
+  // only its samples) and passage nodes (nodes in a gap too narrow for `clearance`, never goals).
+  // >= the controller's bound 0.32 plus its pad 0.5 * sqrt(3) * 0.02 with room to spare (the
+  // body turned 45° reaches 0.354 m), so any path the planner emits passes the controller's check
+  // as a polyline. Nodes and edges away from doorways keep this.
+  double passage_clearance = 0.42;
+  // m: in doorways, less: at most door_length of an edge and passage nodes may come down to this.
+  // A 0.9-1.0 m door mapped 7-8 voxels wide has an ESDF of 0.35 m in its middle (trilinear
+  // between voxel centres; flat over the middle 0.1 m of an 8-voxel gap); 0.34 plus the fine
+  // check's excess (|u|_1 * kFineStep / 2 = 0.005 straight across) fits under it, and is >= the
+  // controller's bound (half_size 0.25 + margin 0.07) plus its pad 0.017. Only in doorways: flying
+  // along a wall at 0.34 m with the body turned 45° (half diagonal 0.354 m) leaves nothing when
+  // the wall's surface is the mapped voxel face.
+  double door_clearance = 0.34;
+  // m: a crossing of a 0.2 m wall sees < passage_clearance for ~0.7 m; env2's 1.5 m passage
+  // takes passage nodes inside.
+  double door_length = 1.0;
+  // m: edges are checked at points this far apart, each vouching for the stretch around it
+  // (CollisionChecker::samples_free); where one falls short, points kFineStep apart decide.
   double edge_step = 0.1;
   // m: near the vehicle an edge from the root is checked only against occupied voxels and the
   // bare vehicle box, so the vehicle can leave a pose whose surroundings are not mapped yet.
