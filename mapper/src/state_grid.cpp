@@ -63,6 +63,7 @@ std::vector<VoxelKey> StateGrid::sorted_block_keys() const {
 void StateGrid::clear() {
   blocks_.clear();
   free_ = occupied_ = 0;
+  ++changes_;
   known_bounds_ = KeyBox();
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "semx/mapper/raycast.hpp"
@@ -16,7 +17,105 @@ CollisionChecker::CollisionChecker(const CollisionConfig& config)
       body_half_(0.5 * config.vehicle_size + Eigen::Vector3d::Constant(config.margin)),
       vehicle_half_(0.5 * config.vehicle_size),
       reach_(body_half_.cwiseMax(
-          Eigen::Vector3d::Constant(std::max(config.clearance, config.passage_clearance)))) {}
+          Eigen::Vector3d::Constant(std::max(config.clearance, config.passage_clearance)))),
+      // Every cap the checks ask for: a clearance plus the slope allowance of half a coarse step.
+      cache_cap_(std::max({config.clearance, config.passage_clearance, config.door_clearance,
+                           kDoorUnknownClearance}) +
+                 0.15) {}
+
+void CollisionChecker::validate_cache() const {
+  if (!grid_) return;
+  const uint64_t stamp[4] = {grid_->changes(), static_cast<uint64_t>(grid_->free_voxels()),
+                             static_cast<uint64_t>(grid_->occupied_voxels()),
+                             static_cast<uint64_t>(grid_->num_blocks())};
+  if (cache_grid_ == grid_ && std::equal(stamp, stamp + 4, cache_stamp_)) return;
+  for (auto& c : centre_cache_) c.clear();
+  cache_grid_ = grid_;
+  std::copy(stamp, stamp + 4, cache_stamp_);
+}
+
+namespace {
+uint64_t pack(const VoxelKey& k) {
+  return (static_cast<uint64_t>(static_cast<uint32_t>(k.x) & 0x1fffff) << 42) |
+         (static_cast<uint64_t>(static_cast<uint32_t>(k.y) & 0x1fffff) << 21) |
+         (static_cast<uint64_t>(static_cast<uint32_t>(k.z) & 0x1fffff));
+}
+}  // namespace
+
+void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& changes) const {
+  if (!cache_grid_ || changes.empty()) return;
+  const double res = cache_grid_->resolution();
+  const int reach = static_cast<int>(std::ceil((cache_cap_ + std::sqrt(3.0) * res + 0.5 * res) / res));
+  const int d = (reach + mapper::kBlockSize - 1) / mapper::kBlockSize;  // blocks a change reaches
+  std::unordered_map<uint64_t, bool> done;
+  for (const mapper::VoxelChange& c : changes) {
+    const VoxelKey b = mapper::block_of(c.key);
+    if (!done.emplace(pack(b), true).second) continue;
+    for (int z = -d; z <= d; ++z)
+      for (int y = -d; y <= d; ++y)
+        for (int x = -d; x <= d; ++x) {
+          const uint64_t k = pack({b.x + x, b.y + y, b.z + z});
+          centre_cache_[0].erase(k);
+          centre_cache_[1].erase(k);
+        }
+  }
+  // What is left is true for the grid as it is now.
+  cache_stamp_[0] = cache_grid_->changes();
+  cache_stamp_[1] = static_cast<uint64_t>(cache_grid_->free_voxels());
+  cache_stamp_[2] = static_cast<uint64_t>(cache_grid_->occupied_voxels());
+  cache_stamp_[3] = static_cast<uint64_t>(cache_grid_->num_blocks());
+}
+
+double CollisionChecker::centre_value(const VoxelKey& c, bool unknown_is_obstacle) const {
+  auto [it, inserted] = centre_cache_[unknown_is_obstacle ? 1 : 0].try_emplace(pack(mapper::block_of(c)));
+  CacheBlock& block = it->second;
+  if (inserted) block.fill(std::numeric_limits<double>::quiet_NaN());
+  double& slot = block[static_cast<size_t>(mapper::local_index(c))];
+  if (!std::isnan(slot)) return slot;
+  const double res = grid_->resolution();
+  // Exact below cache_cap_ + diagonal + half a voxel (what esdf() needs for any cap up to
+  // cache_cap_); an obstacle outside the searched cube is at least `reach` voxels away.
+  const int reach = static_cast<int>(std::ceil((cache_cap_ + std::sqrt(3.0) * res + 0.5 * res) / res));
+  int64_t best2 = static_cast<int64_t>(reach) * reach;
+  const VoxelKey kmin{c.x - reach, c.y - reach, c.z - reach}, kmax{c.x + reach, c.y + reach, c.z + reach};
+  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
+  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
+    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
+      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
+        const mapper::VoxelBlock* b = grid_->find_block({bx, by, bz});
+        if (!b && !unknown_is_obstacle) continue;
+        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
+        const int x0 = std::max(kmin.x, base.x) - base.x,
+                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
+        const int y0 = std::max(kmin.y, base.y) - base.y,
+                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
+        const int z0 = std::max(kmin.z, base.z) - base.z,
+                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
+        for (int z = z0; z <= z1; ++z) {
+          const int64_t dz = base.z + z - c.z;
+          for (int y = y0; y <= y1; ++y) {
+            const int64_t dy = base.y + y - c.y;
+            const int64_t dyz = dy * dy + dz * dz;
+            if (dyz >= best2) continue;
+            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
+                                                                      (y << mapper::kBlockBits))]
+                                      : nullptr;
+            for (int x = x0; x <= x1; ++x) {
+              if (row ? (row[x] == VoxelState::kFree ||
+                         (row[x] == VoxelState::kUnknown && !unknown_is_obstacle))
+                      : !unknown_is_obstacle)
+                continue;
+              const int64_t dx = base.x + x - c.x;
+              best2 = std::min(best2, dx * dx + dyz);
+            }
+          }
+        }
+      }
+    }
+  }
+  slot = std::sqrt(static_cast<double>(best2)) * res - 0.5 * res;
+  return slot;
+}
 
 bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double radius,
                                    bool unknown_is_occupied) const {
@@ -80,6 +179,27 @@ bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector
 double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown_is_obstacle) const {
   ++box_checks_;
   if (!grid_ || !p.allFinite()) return -1.0;
+  if (cap <= cache_cap_) {
+    const double res = grid_->resolution(), inv = 1.0 / res;
+    Eigen::Vector3d f;
+    int32_t c0[3];
+    for (int i = 0; i < 3; ++i) {
+      const double u = p[i] * inv - 0.5;
+      const double fl = std::floor(u);
+      if (std::abs(fl) >= mapper::kMaxKeyMagnitude - 64) return -1.0;
+      c0[i] = static_cast<int32_t>(fl);
+      f[i] = u - fl;
+    }
+    validate_cache();
+    double v = 0.0;
+    for (int c = 0; c < 8; ++c) {
+      double w = 1.0;
+      for (int i = 0; i < 3; ++i) w *= ((c >> i) & 1) ? f[i] : 1.0 - f[i];
+      if (w == 0.0) continue;
+      v += w * centre_value({c0[0] + (c & 1), c0[1] + ((c >> 1) & 1), c0[2] + ((c >> 2) & 1)}, unknown_is_obstacle);
+    }
+    return v;
+  }
   const double res = grid_->resolution(), inv = 1.0 / res;
   // The 8 voxel centres around p, as the controller's trilinear interpolation uses them.
   Eigen::Vector3d f;

@@ -36,6 +36,7 @@ void DepStrategy::reset() {
 }
 
 void DepStrategy::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+  checker_.note_changes(changes);
   for (const mapper::VoxelChange& c : changes) {
     const VoxelKey b = mapper::block_of(c.key);
     changed_blocks_.insert(b);

@@ -54,6 +54,7 @@ class StateGrid {
   // Writers that change block->state[i] directly must report it here.
   void note_transition(VoxelBlock& b, const VoxelKey& k, VoxelState before, VoxelState after) {
     if (before == after) return;
+    ++changes_;
     adjust(before, -1);
     adjust(after, +1);
     if (before == VoxelState::kUnknown) {
@@ -64,6 +65,9 @@ class StateGrid {
     }
   }
   size_t num_blocks() const { return blocks_.size(); }
+  // Grows with every state transition (and clear()): readers that cache what they derived from
+  // the grid compare it to know whether their cache still holds.
+  uint64_t changes() const { return changes_; }
   // Block keys in ascending (z, y, x) order, so every serialisation is deterministic.
   std::vector<VoxelKey> sorted_block_keys() const;
   template <class F>
@@ -135,6 +139,7 @@ class StateGrid {
   std::unordered_map<uint64_t, std::unique_ptr<VoxelBlock>, BlockHash> blocks_;
   int64_t free_ = 0;
   int64_t occupied_ = 0;
+  uint64_t changes_ = 0;
   KeyBox known_bounds_;
 };
 

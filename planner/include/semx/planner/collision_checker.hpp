@@ -22,8 +22,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <unordered_map>
+#include <array>
+#include <vector>
 #include <cstdint>
 
+#include "semx/mapper/map_delta.hpp"
 #include "semx/mapper/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
 
@@ -61,6 +65,10 @@ class CollisionChecker {
   // passages get nodes and edges.
   bool centre(Eigen::Vector3d& p, int iterations = 3, double max_step = 0.3, bool passage = false) const;
 
+  // The grid changed at these voxels and nowhere else since the checker last looked: cached ESDF
+  // values near them are dropped, the rest kept (any other change drops the whole cache).
+  void note_changes(const std::vector<mapper::VoxelChange>& changes) const;
+
   // Box checks made so far (for the planning-time charge); reset by the caller.
   int64_t box_checks() const { return box_checks_; }
   void reset_counters() const { box_checks_ = 0; }
@@ -79,8 +87,21 @@ class CollisionChecker {
   Eigen::Vector3d body_half_;     // vehicle box + margin
   Eigen::Vector3d vehicle_half_;  // bare vehicle box
   Eigen::Vector3d reach_;         // max(body_half_, clearance) per axis
+  // The ESDF at one voxel centre (before trilinear interpolation), exact below cache_cap_ +
+  // a voxel diagonal + half a voxel and a lower bound above; cached until the grid changes.
+  double centre_value(const mapper::VoxelKey& c, bool unknown_is_obstacle) const;
+  void validate_cache() const;
+
   const mapper::StateGrid* grid_ = nullptr;
   mutable int64_t box_checks_ = 0;
+  // Edge points 0.1 m and 0.01 m apart share most of their 8 corner centres, and edges share
+  // them with their neighbours: caching the centres' values instead of searching around every
+  // point made the cycle ~10x cheaper (semx-perf-planner). Keyed per unknown rule.
+  double cache_cap_ = 0.0;
+  using CacheBlock = std::array<double, mapper::kBlockVolume>;  // NaN: not computed yet
+  mutable std::unordered_map<uint64_t, CacheBlock> centre_cache_[2];
+  mutable const mapper::StateGrid* cache_grid_ = nullptr;
+  mutable uint64_t cache_stamp_[4] = {0, 0, 0, 0};
 };
 
 }  // namespace semx::planner
