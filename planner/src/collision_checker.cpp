@@ -23,18 +23,52 @@ CollisionChecker::CollisionChecker(const CollisionConfig& config)
                            kDoorUnknownClearance}) +
                  0.15) {}
 
-void CollisionChecker::validate_cache() const {
-  if (!grid_) return;
-  const uint64_t stamp[4] = {grid_->changes(), static_cast<uint64_t>(grid_->free_voxels()),
-                             static_cast<uint64_t>(grid_->occupied_voxels()),
-                             static_cast<uint64_t>(grid_->num_blocks())};
-  if (cache_grid_ == grid_ && std::equal(stamp, stamp + 4, cache_stamp_)) return;
-  for (auto& c : centre_cache_) c.clear();
-  cache_grid_ = grid_;
-  std::copy(stamp, stamp + 4, cache_stamp_);
+namespace {
+
+// Calls visit(x, y, z) for every obstacle voxel (occupied; unknown too when unknown_is_obstacle,
+// including voxels of blocks never allocated) in the key box [kmin, kmax], block by block, and
+// skips the rows row_wanted(y, z) declines. Stops and returns false when visit returns false.
+template <class RowWanted, class Visit>
+bool for_each_obstacle(const mapper::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
+                       bool unknown_is_obstacle, RowWanted&& row_wanted, Visit&& visit) {
+  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
+  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
+    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
+      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
+        const mapper::VoxelBlock* b = grid.find_block({bx, by, bz});
+        if (!b && !unknown_is_obstacle) continue;
+        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
+        const int x0 = std::max(kmin.x, base.x) - base.x,
+                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
+        const int y0 = std::max(kmin.y, base.y) - base.y,
+                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
+        const int z0 = std::max(kmin.z, base.z) - base.z,
+                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
+        for (int z = z0; z <= z1; ++z) {
+          for (int y = y0; y <= y1; ++y) {
+            if (!row_wanted(base.y + y, base.z + z)) continue;
+            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
+                                                                      (y << mapper::kBlockBits))]
+                                      : nullptr;
+            for (int x = x0; x <= x1; ++x) {
+              const VoxelState st = row ? row[x] : VoxelState::kUnknown;
+              if (st == VoxelState::kFree || (st == VoxelState::kUnknown && !unknown_is_obstacle)) continue;
+              if (!visit(base.x + x, base.y + y, base.z + z)) return false;
+            }
+          }
+        }
+      }
+    }
+  }
+  return true;
 }
 
-namespace {
+// What changes whenever the grid does (changes() alone could repeat after a grid was replaced).
+std::array<uint64_t, 4> stamp_of(const mapper::StateGrid& g) {
+  return {g.changes(), static_cast<uint64_t>(g.free_voxels()), static_cast<uint64_t>(g.occupied_voxels()),
+          static_cast<uint64_t>(g.num_blocks())};
+}
+
 uint64_t pack(const VoxelKey& k) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(k.x) & 0x1fffff) << 42) |
          (static_cast<uint64_t>(static_cast<uint32_t>(k.y) & 0x1fffff) << 21) |
@@ -42,10 +76,24 @@ uint64_t pack(const VoxelKey& k) {
 }
 }  // namespace
 
+void CollisionChecker::validate_cache() const {
+  if (!grid_) return;
+  const std::array<uint64_t, 4> stamp = stamp_of(*grid_);
+  if (cache_grid_ == grid_ && stamp == cache_stamp_) return;
+  for (auto& c : centre_cache_) c.clear();
+  cache_grid_ = grid_;
+  cache_stamp_ = stamp;
+}
+
+int CollisionChecker::reach_for(double cap, double res) {
+  // Exact below cap + a voxel diagonal + half a voxel, which esdf() needs for `cap`; an obstacle
+  // outside the searched cube is at least this many voxels away.
+  return static_cast<int>(std::ceil((cap + std::sqrt(3.0) * res + 0.5 * res) / res));
+}
+
 void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& changes) const {
   if (!cache_grid_ || changes.empty()) return;
-  const double res = cache_grid_->resolution();
-  const int reach = static_cast<int>(std::ceil((cache_cap_ + std::sqrt(3.0) * res + 0.5 * res) / res));
+  const int reach = reach_for(cache_cap_, cache_grid_->resolution());
   const int d = (reach + mapper::kBlockSize - 1) / mapper::kBlockSize;  // blocks a change reaches
   std::unordered_map<uint64_t, bool> done;
   for (const mapper::VoxelChange& c : changes) {
@@ -59,11 +107,7 @@ void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& chan
           centre_cache_[1].erase(k);
         }
   }
-  // What is left is true for the grid as it is now.
-  cache_stamp_[0] = cache_grid_->changes();
-  cache_stamp_[1] = static_cast<uint64_t>(cache_grid_->free_voxels());
-  cache_stamp_[2] = static_cast<uint64_t>(cache_grid_->occupied_voxels());
-  cache_stamp_[3] = static_cast<uint64_t>(cache_grid_->num_blocks());
+  cache_stamp_ = stamp_of(*cache_grid_);  // what is left is true for the grid as it is now
 }
 
 double CollisionChecker::centre_value(const VoxelKey& c, bool unknown_is_obstacle) const {
@@ -71,50 +115,27 @@ double CollisionChecker::centre_value(const VoxelKey& c, bool unknown_is_obstacl
   CacheBlock& block = it->second;
   if (inserted) block.fill(std::numeric_limits<double>::quiet_NaN());
   double& slot = block[static_cast<size_t>(mapper::local_index(c))];
-  if (!std::isnan(slot)) return slot;
-  const double res = grid_->resolution();
-  // Exact below cache_cap_ + diagonal + half a voxel (what esdf() needs for any cap up to
-  // cache_cap_); an obstacle outside the searched cube is at least `reach` voxels away.
-  const int reach = static_cast<int>(std::ceil((cache_cap_ + std::sqrt(3.0) * res + 0.5 * res) / res));
+  if (std::isnan(slot))
+    slot = centre_search(c, reach_for(cache_cap_, grid_->resolution()), unknown_is_obstacle);
+  return slot;
+}
+
+double CollisionChecker::centre_search(const VoxelKey& c, int reach, bool unknown_is_obstacle) const {
   int64_t best2 = static_cast<int64_t>(reach) * reach;
   const VoxelKey kmin{c.x - reach, c.y - reach, c.z - reach}, kmax{c.x + reach, c.y + reach, c.z + reach};
-  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
-  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
-    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
-      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const mapper::VoxelBlock* b = grid_->find_block({bx, by, bz});
-        if (!b && !unknown_is_obstacle) continue;
-        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
-        const int x0 = std::max(kmin.x, base.x) - base.x,
-                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
-        const int y0 = std::max(kmin.y, base.y) - base.y,
-                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
-        const int z0 = std::max(kmin.z, base.z) - base.z,
-                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
-        for (int z = z0; z <= z1; ++z) {
-          const int64_t dz = base.z + z - c.z;
-          for (int y = y0; y <= y1; ++y) {
-            const int64_t dy = base.y + y - c.y;
-            const int64_t dyz = dy * dy + dz * dz;
-            if (dyz >= best2) continue;
-            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
-                                                                      (y << mapper::kBlockBits))]
-                                      : nullptr;
-            for (int x = x0; x <= x1; ++x) {
-              if (row ? (row[x] == VoxelState::kFree ||
-                         (row[x] == VoxelState::kUnknown && !unknown_is_obstacle))
-                      : !unknown_is_obstacle)
-                continue;
-              const int64_t dx = base.x + x - c.x;
-              best2 = std::min(best2, dx * dx + dyz);
-            }
-          }
-        }
-      }
-    }
-  }
-  slot = std::sqrt(static_cast<double>(best2)) * res - 0.5 * res;
-  return slot;
+  for_each_obstacle(
+      *grid_, kmin, kmax, unknown_is_obstacle,
+      [&](int32_t y, int32_t z) {
+        const int64_t dy = y - c.y, dz = z - c.z;
+        return dy * dy + dz * dz < best2;
+      },
+      [&](int32_t x, int32_t y, int32_t z) {
+        const int64_t dx = x - c.x, dy = y - c.y, dz = z - c.z;
+        best2 = std::min(best2, dx * dx + dy * dy + dz * dz);
+        return true;
+      });
+  const double res = grid_->resolution();
+  return std::sqrt(static_cast<double>(best2)) * res - 0.5 * res;
 }
 
 bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double radius,
@@ -146,60 +167,14 @@ bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector
     }
     return in_box || (radius > 0 && d2 < r2);
   };
-  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
-  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
-    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
-      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const mapper::VoxelBlock* b = grid_->find_block({bx, by, bz});
-        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
-        const int x0 = std::max(kmin.x, base.x) - base.x,
-                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
-        const int y0 = std::max(kmin.y, base.y) - base.y,
-                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
-        const int z0 = std::max(kmin.z, base.z) - base.z,
-                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
-        for (int z = z0; z <= z1; ++z) {
-          for (int y = y0; y <= y1; ++y) {
-            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
-                                                                      (y << mapper::kBlockBits))]
-                                      : nullptr;
-            for (int x = x0; x <= x1; ++x) {
-              const VoxelState s = row ? row[x] : VoxelState::kUnknown;
-              if (s == VoxelState::kFree || (s == VoxelState::kUnknown && !unknown_is_occupied)) continue;
-              if (blocks(base.x + x, base.y + y, base.z + z)) return false;
-            }
-          }
-        }
-      }
-    }
-  }
-  return true;
+  return for_each_obstacle(
+      *grid_, kmin, kmax, unknown_is_occupied, [](int32_t, int32_t) { return true; },
+      [&](int32_t x, int32_t y, int32_t z) { return !blocks(x, y, z); });
 }
 
 double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown_is_obstacle) const {
   ++box_checks_;
   if (!grid_ || !p.allFinite()) return -1.0;
-  if (cap <= cache_cap_) {
-    const double res = grid_->resolution(), inv = 1.0 / res;
-    Eigen::Vector3d f;
-    int32_t c0[3];
-    for (int i = 0; i < 3; ++i) {
-      const double u = p[i] * inv - 0.5;
-      const double fl = std::floor(u);
-      if (std::abs(fl) >= mapper::kMaxKeyMagnitude - 64) return -1.0;
-      c0[i] = static_cast<int32_t>(fl);
-      f[i] = u - fl;
-    }
-    validate_cache();
-    double v = 0.0;
-    for (int c = 0; c < 8; ++c) {
-      double w = 1.0;
-      for (int i = 0; i < 3; ++i) w *= ((c >> i) & 1) ? f[i] : 1.0 - f[i];
-      if (w == 0.0) continue;
-      v += w * centre_value({c0[0] + (c & 1), c0[1] + ((c >> 1) & 1), c0[2] + ((c >> 2) & 1)}, unknown_is_obstacle);
-    }
-    return v;
-  }
   const double res = grid_->resolution(), inv = 1.0 / res;
   // The 8 voxel centres around p, as the controller's trilinear interpolation uses them.
   Eigen::Vector3d f;
@@ -211,65 +186,21 @@ double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown
     c0[i] = static_cast<int32_t>(fl);
     f[i] = u - fl;
   }
-  // Obstacles (occupied or unknown) within `search` of p on every axis. A corner that has none
-  // there is at least search - half a voxel diagonal from any: that lower bound stands in for it.
   // Corner values differ by at most a voxel diagonal, so when the result is below cap every
-  // corner is below cap + diagonal, which this search finds exactly.
-  const double diagonal = std::sqrt(3.0) * res;
-  const double search = cap + 1.5 * diagonal + 0.5 * res + 1e-6;
-  const double far = search - 0.5 * diagonal;
-  double best2[8];
-  for (double& b : best2) b = far * far;
-  VoxelKey kmin, kmax;
-  for (int i = 0; i < 3; ++i) {
-    kmin[i] = static_cast<int32_t>(std::floor((p[i] - search) * inv));
-    kmax[i] = static_cast<int32_t>(std::floor((p[i] + search) * inv));
-  }
-  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
-  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
-    for (int32_t by = bmin.y; by <= bmax.y; ++by) {
-      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const mapper::VoxelBlock* b = grid_->find_block({bx, by, bz});
-        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
-        const int x0 = std::max(kmin.x, base.x) - base.x,
-                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
-        const int y0 = std::max(kmin.y, base.y) - base.y,
-                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
-        const int z0 = std::max(kmin.z, base.z) - base.z,
-                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
-        for (int z = z0; z <= z1; ++z) {
-          for (int y = y0; y <= y1; ++y) {
-            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
-                                                                      (y << mapper::kBlockBits))]
-                                      : nullptr;
-            for (int x = x0; x <= x1; ++x) {
-              if (row ? (row[x] == VoxelState::kFree ||
-                         (row[x] == VoxelState::kUnknown && !unknown_is_obstacle))
-                      : !unknown_is_obstacle)
-                continue;
-              // Integer voxel offsets from the corners: centre distances are exact multiples.
-              const int32_t k[3] = {base.x + x, base.y + y, base.z + z};
-              for (int c = 0; c < 8; ++c) {
-                double d2 = 0.0;
-                for (int i = 0; i < 3; ++i) {
-                  const double d = (k[i] - (c0[i] + ((c >> i) & 1))) * res;
-                  d2 += d * d;
-                }
-                best2[c] = std::min(best2[c], d2);
-              }
-            }
-          }
-        }
-      }
-    }
-  }
-  // The mapper's value at a free voxel: centre-to-centre distance minus half a voxel (an obstacle
-  // voxel itself reads -half a voxel here, which fails every positive requirement).
+  // corner is below cap + diagonal, which a centre's search of reach_for(cap) finds exactly;
+  // above it the search's lower bound stands in. The cache serves every cap the checks use.
+  const bool cached = cap <= cache_cap_;
+  if (cached) validate_cache();
+  const int reach = cached ? 0 : reach_for(cap, res);
   double v = 0.0;
   for (int c = 0; c < 8; ++c) {
     double w = 1.0;
     for (int i = 0; i < 3; ++i) w *= ((c >> i) & 1) ? f[i] : 1.0 - f[i];
-    v += w * (std::sqrt(best2[c]) - 0.5 * res);
+    if (w == 0.0) continue;
+    const VoxelKey k{c0[0] + (c & 1), c0[1] + ((c >> 1) & 1), c0[2] + ((c >> 2) & 1)};
+    // The mapper's value at a free voxel: centre-to-centre distance minus half a voxel (an
+    // obstacle voxel itself reads -half a voxel, which fails every positive requirement).
+    v += w * (cached ? centre_value(k, unknown_is_obstacle) : centre_search(k, reach, unknown_is_obstacle));
   }
   return v;
 }

@@ -22,10 +22,10 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <unordered_map>
 #include <array>
-#include <vector>
 #include <cstdint>
+#include <unordered_map>
+#include <vector>
 
 #include "semx/mapper/map_delta.hpp"
 #include "semx/mapper/state_grid.hpp"
@@ -90,6 +90,9 @@ class CollisionChecker {
   // The ESDF at one voxel centre (before trilinear interpolation), exact below cache_cap_ +
   // a voxel diagonal + half a voxel and a lower bound above; cached until the grid changes.
   double centre_value(const mapper::VoxelKey& c, bool unknown_is_obstacle) const;
+  // The same, uncached, searching `reach` voxels around c.
+  double centre_search(const mapper::VoxelKey& c, int reach, bool unknown_is_obstacle) const;
+  static int reach_for(double cap, double res);
   void validate_cache() const;
 
   const mapper::StateGrid* grid_ = nullptr;
@@ -101,7 +104,7 @@ class CollisionChecker {
   using CacheBlock = std::array<double, mapper::kBlockVolume>;  // NaN: not computed yet
   mutable std::unordered_map<uint64_t, CacheBlock> centre_cache_[2];
   mutable const mapper::StateGrid* cache_grid_ = nullptr;
-  mutable uint64_t cache_stamp_[4] = {0, 0, 0, 0};
+  mutable std::array<uint64_t, 4> cache_stamp_{};
 };
 
 }  // namespace semx::planner
