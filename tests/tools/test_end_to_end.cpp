@@ -38,8 +38,8 @@ DemoRun run_demo(const std::string& name, int port_offset) {
   fs::remove_all(r.dir);
   const std::string out = r.dir + ".out";
   const std::string url = semx::runtime::udpm_url_for_port(test_port(port_offset));
-  Process launcher({bin("semx-launch"), "demo", "--lcm-url", url, "--no-color", "--arg", "out=" + r.dir, "--arg",
-                    "time_limit=" + std::to_string(kTimeLimit), "--arg", "progress=5"},
+  Process launcher({bin("semx-launch"), "demo", "--lcm-url", url, "--no-color", "--arg", "out=" + r.dir,
+                    "--arg", "time_limit=" + std::to_string(kTimeLimit), "--arg", "progress=5"},
                    out);
   r.exit_code = launcher.wait(400);
   r.console = read_file(out);

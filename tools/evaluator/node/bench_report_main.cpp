@@ -26,11 +26,12 @@ int main(int argc, char** argv) {
     std::string root, out;
     evaluator::BenchReportOptions o;
     int64_t samples = o.comparison_samples;
-    runtime::ArgParser p("semx-bench-report",
-                         "Summarises every run folder under DIR (metrics.json, coverage.csv) as the paper's\n"
-                         "tables (mean ± std over seeds): the sampling-density sweep, the planner comparison and\n"
-                         "the margins of semantic-dep over each baseline; writes DIR/tables.md, DIR/results.csv\n"
-                         "and DIR/coverage_WORLD.png, and prints the tables.");
+    runtime::ArgParser p(
+        "semx-bench-report",
+        "Summarises every run folder under DIR (metrics.json, coverage.csv) as the paper's\n"
+        "tables (mean ± std over seeds): the sampling-density sweep, the planner comparison and\n"
+        "the margins of semantic-dep over each baseline; writes DIR/tables.md, DIR/results.csv\n"
+        "and DIR/coverage_WORLD.png, and prints the tables.");
     p.positional("DIR", "a ./semx bench output folder (run folders anywhere below it)", &root)
         .option("out", "DIR", "where to write the report (default: DIR)", &out)
         .option("sweep-planner", "NAME", "the planner of the sampling-density table (default semantic-dep)",

@@ -24,7 +24,8 @@ const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-d
 
 int planner_rank(const std::string& p) {
   const auto it = std::find(kPlannerOrder.begin(), kPlannerOrder.end(), p);
-  return it == kPlannerOrder.end() ? static_cast<int>(kPlannerOrder.size()) : static_cast<int>(it - kPlannerOrder.begin());
+  return it == kPlannerOrder.end() ? static_cast<int>(kPlannerOrder.size())
+                                   : static_cast<int>(it - kPlannerOrder.begin());
 }
 
 std::vector<std::string> planners_of(const std::vector<const BenchRun*>& runs) {
@@ -86,11 +87,13 @@ std::string time_r_cell(const Group& g) {
   return cell;
 }
 
-Group select(const std::vector<BenchRun>& runs, const std::string& world, const std::string& planner, int samples) {
+Group select(const std::vector<BenchRun>& runs, const std::string& world, const std::string& planner,
+             int samples) {
   Group g;
   for (const auto& r : runs)
     if (r.world == world && r.planner == planner && r.samples == samples) g.runs.push_back(&r);
-  std::sort(g.runs.begin(), g.runs.end(), [](const BenchRun* a, const BenchRun* b) { return a->seed < b->seed; });
+  std::sort(g.runs.begin(), g.runs.end(),
+            [](const BenchRun* a, const BenchRun* b) { return a->seed < b->seed; });
   return g;
 }
 
@@ -138,7 +141,9 @@ BenchRun load_bench_run(const std::string& dir) {
     throw std::runtime_error(file + ": " + e.what());
   }
   if (!m.IsMap()) throw std::runtime_error(file + ": not a JSON object");
-  auto text = [&](const char* key) { return m[key] && m[key].IsScalar() ? m[key].as<std::string>() : std::string(); };
+  auto text = [&](const char* key) {
+    return m[key] && m[key].IsScalar() ? m[key].as<std::string>() : std::string();
+  };
   r.world = text("world");
   r.planner = text("planner");
   r.termination = text("termination");
@@ -198,9 +203,9 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
     for (int n : densities) {
       const Group g = select(runs, w, o.sweep_planner, n);
       if (g.runs.empty()) continue;
-      md << "| " << w << " | " << n << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s)) << " | "
-         << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct)) << " | "
-         << time_r_cell(g) << " | " << g.collisions() << " |\n";
+      md << "| " << w << " | " << n << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
+         << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
+         << " | " << time_r_cell(g) << " | " << g.collisions() << " |\n";
     }
   }
 
@@ -213,9 +218,9 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
     for (const auto& p : planners_of(here)) {
       const Group g = select(runs, w, p, o.comparison_samples);
-      md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s)) << " | "
-         << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct)) << " | "
-         << time_r_cell(g) << " | " << g.collisions() << " |\n";
+      md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
+         << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
+         << " | " << time_r_cell(g) << " | " << g.collisions() << " |\n";
     }
   }
 
@@ -238,11 +243,15 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       const Group theirs = select(runs, w, p, o.comparison_samples);
       int ro = 0, rt = 0;
       const Stat tro = ours.time_r(&ro), trt = theirs.time_r(&rt);
-      const std::string time_r = ro == 0 || rt == 0 ? (ro > 0 ? "only ours reached 85 %" : rt > 0 ? "only theirs reached 85 %" : "–")
-                                                     : pct(tro.mean, trt.mean);
-      const double dc = ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
-      md << "| " << w << " | " << p << " | " << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean)
-         << " | " << time_r << " | "
+      const std::string time_r = ro == 0 || rt == 0 ? (ro > 0   ? "only ours reached 85 %"
+                                                       : rt > 0 ? "only theirs reached 85 %"
+                                                                : "–")
+                                                    : pct(tro.mean, trt.mean);
+      const double dc =
+          ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
+      md << "| " << w << " | " << p << " | "
+         << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean) << " | "
+         << time_r << " | "
          << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
          << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
     }
@@ -252,19 +261,21 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
     wall += r.wall_s;
     sim += r.sim_s;
   }
-  md << "\n" << runs.size() << " runs, " << fmt(sim, 0) << " simulated s in " << fmt(wall, 0)
+  md << "\n"
+     << runs.size() << " runs, " << fmt(sim, 0) << " simulated s in " << fmt(wall, 0)
      << " wall s of exploration (" << fmt(wall > 0 ? sim / wall : 0, 1) << "x real time).\n";
   return md.str();
 }
 
 std::string bench_csv(const std::vector<BenchRun>& runs) {
   std::ostringstream c;
-  c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,termination,dir\n";
+  c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
+       "termination,dir\n";
   for (const auto& r : runs) {
     c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
       << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
-      << (r.time_r_s ? fmt(*r.time_r_s, 3) : std::string()) << ',' << r.collisions << ',' << fmt(r.wall_s, 2) << ','
-      << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << '\n';
+      << (r.time_r_s ? fmt(*r.time_r_s, 3) : std::string()) << ',' << r.collisions << ',' << fmt(r.wall_s, 2)
+      << ',' << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << '\n';
   }
   return c.str();
 }
@@ -300,7 +311,8 @@ std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, co
       series.push_back(std::move(s));
     }
     CoveragePlotOptions po;
-    po.title = w + ": coverage over time, mean over seeds (" + std::to_string(o.comparison_samples) + " samples)";
+    po.title =
+        w + ": coverage over time, mean over seeds (" + std::to_string(o.comparison_samples) + " samples)";
     po.threshold_pct = o.threshold_pct;
     const std::string file = (fs::path(dir) / ("coverage_" + w + ".png")).string();
     write_coverage_plot(file, series, po);

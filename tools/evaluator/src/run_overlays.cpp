@@ -44,7 +44,8 @@ void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions)
   }
   if (!regions.empty()) {
     picture.add_legend("semantic regions, active", kActiveRegion);
-    picture.add_legend("semantic regions, observed (" + std::to_string(regions.size()) + " in all)", kDoneRegion);
+    picture.add_legend("semantic regions, observed (" + std::to_string(regions.size()) + " in all)",
+                       kDoneRegion);
   }
 }
 
@@ -63,7 +64,8 @@ int64_t write_octomap_bt(const mapper::StateGrid& grid, const std::string& path)
       if (k.x < -kOctoOffset || k.x >= kOctoOffset || k.y < -kOctoOffset || k.y >= kOctoOffset ||
           k.z < -kOctoOffset || k.z >= kOctoOffset)
         continue;
-      const octomap::OcTreeKey ok(static_cast<uint16_t>(k.x + kOctoOffset), static_cast<uint16_t>(k.y + kOctoOffset),
+      const octomap::OcTreeKey ok(static_cast<uint16_t>(k.x + kOctoOffset),
+                                  static_cast<uint16_t>(k.y + kOctoOffset),
                                   static_cast<uint16_t>(k.z + kOctoOffset));
       tree.setNodeValue(ok, s == mapper::VoxelState::kOccupied ? occupied : free, /*lazy_eval=*/true);
       ++written;
