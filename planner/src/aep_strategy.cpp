@@ -211,18 +211,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
 
   PlanOutcome out;
   if (best_ >= 0 && tree_[static_cast<size_t>(best_)].gain.gain >= a.g_zero) {
-    const int first = first_on_branch(tree_, best_);
-    const TreeNode& f = tree_[static_cast<size_t>(first)];
-    Goal& g = out.goal;
-    g.valid = true;
-    g.position = f.position;
-    g.yaw = f.gain.yaw;
-    g.gain = f.gain.gain;
-    g.cost = travel_time(f.cost, ctx.pose.yaw, f.gain.yaw, config_.cost);
-    g.score = tree_[static_cast<size_t>(best_)].value;
-    g.waypoints = first == 0 ? std::vector<Eigen::Vector3d>{ctx.pose.position}
-                             : std::vector<Eigen::Vector3d>{ctx.pose.position, f.position};
-    g.yaws = interpolate_yaws(g.waypoints, ctx.pose.yaw, g.yaw);
+    out.goal = first_edge_goal(tree_, best_, ctx.pose, config_.cost);
   } else {
     // Frontier fallback over the global graph.
     fallback_ = true;

@@ -140,22 +140,25 @@ PlanOutcome NbvStrategy::plan(PlanContext& ctx) {
     out.reason = r.str();
     return out;
   }
-  const int first = first_on_branch(tree_, best_);
-  const TreeNode& f = tree_[static_cast<size_t>(first)];
-  Goal& g = out.goal;
+  out.goal = first_edge_goal(tree_, best_, ctx.pose, config_.cost);
+  return out;
+}
+
+Goal first_edge_goal(const std::vector<TreeNode>& tree, int best, const VehiclePose& pose,
+                     const CostConfig& cost) {
+  const int first = first_on_branch(tree, best);
+  const TreeNode& f = tree[static_cast<size_t>(first)];
+  Goal g;
   g.valid = true;
   g.position = f.position;
   g.yaw = f.gain.yaw;
   g.gain = f.gain.gain;
-  g.cost = travel_time(f.cost, ctx.pose.yaw, f.gain.yaw, config_.cost);
-  g.score = tree_[static_cast<size_t>(best_)].value;
-  if (first == 0) {
-    g.waypoints = {ctx.pose.position};
-  } else {
-    g.waypoints = {ctx.pose.position, f.position};
-  }
-  g.yaws = interpolate_yaws(g.waypoints, ctx.pose.yaw, g.yaw);
-  return out;
+  g.cost = travel_time(f.cost, pose.yaw, f.gain.yaw, cost);
+  g.score = tree[static_cast<size_t>(best)].value;
+  g.waypoints = first == 0 ? std::vector<Eigen::Vector3d>{pose.position}
+                           : std::vector<Eigen::Vector3d>{pose.position, f.position};
+  g.yaws = interpolate_yaws(g.waypoints, pose.yaw, g.yaw);
+  return g;
 }
 
 RoadmapView NbvStrategy::roadmap(const Goal*) const {

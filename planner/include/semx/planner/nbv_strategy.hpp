@@ -57,6 +57,10 @@ class NbvStrategy : public Strategy {
 int nearest_tree_node(const std::vector<TreeNode>& tree, const Eigen::Vector3d& p);
 // The root's child on the branch to `node` (the first edge to fly), or `node` when it is the root.
 int first_on_branch(const std::vector<TreeNode>& tree, int node);
+// The receding-horizon goal: the first node on the branch to `best` (its yaw and gain), scored
+// with `best`'s value, reached from the vehicle's pose in one straight edge.
+Goal first_edge_goal(const std::vector<TreeNode>& tree, int best, const VehiclePose& pose,
+                     const CostConfig& cost);
 // A tree as a roadmap view (edges parent-child), with `best` flagged GOAL and its branch ON_PATH.
 RoadmapView tree_view(const std::vector<TreeNode>& tree, int best, int first);
 
