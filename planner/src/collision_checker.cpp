@@ -69,6 +69,11 @@ std::array<uint64_t, 4> stamp_of(const mapper::StateGrid& g) {
           static_cast<uint64_t>(g.num_blocks())};
 }
 
+VoxelKey chunk_of(const VoxelKey& k) {
+  return {k.x >> CollisionChecker::kChunkBits, k.y >> CollisionChecker::kChunkBits,
+          k.z >> CollisionChecker::kChunkBits};
+}
+
 uint64_t pack(const VoxelKey& k) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(k.x) & 0x1fffff) << 42) |
          (static_cast<uint64_t>(static_cast<uint32_t>(k.y) & 0x1fffff) << 21) |
@@ -94,10 +99,10 @@ int CollisionChecker::reach_for(double cap, double res) {
 void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& changes) const {
   if (!cache_grid_ || changes.empty()) return;
   const int reach = reach_for(cache_cap_, cache_grid_->resolution());
-  const int d = (reach + mapper::kBlockSize - 1) / mapper::kBlockSize;  // blocks a change reaches
+  const int d = (reach + kChunkSize - 1) / kChunkSize;  // chunks a change reaches
   std::unordered_map<uint64_t, bool> done;
   for (const mapper::VoxelChange& c : changes) {
-    const VoxelKey b = mapper::block_of(c.key);
+    const VoxelKey b = chunk_of(c.key);
     if (!done.emplace(pack(b), true).second) continue;
     for (int z = -d; z <= d; ++z)
       for (int y = -d; y <= d; ++y)
@@ -111,13 +116,82 @@ void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& chan
 }
 
 double CollisionChecker::centre_value(const VoxelKey& c, bool unknown_is_obstacle) const {
-  auto [it, inserted] = centre_cache_[unknown_is_obstacle ? 1 : 0].try_emplace(pack(mapper::block_of(c)));
-  CacheBlock& block = it->second;
-  if (inserted) block.fill(std::numeric_limits<double>::quiet_NaN());
-  double& slot = block[static_cast<size_t>(mapper::local_index(c))];
-  if (std::isnan(slot))
-    slot = centre_search(c, reach_for(cache_cap_, grid_->resolution()), unknown_is_obstacle);
-  return slot;
+  const VoxelKey chunk = chunk_of(c);
+  auto [it, inserted] = centre_cache_[unknown_is_obstacle ? 1 : 0].try_emplace(pack(chunk));
+  if (inserted) fill_chunk(chunk, unknown_is_obstacle, it->second);
+  return it->second[static_cast<size_t>((c.x & kChunkMask) | ((c.y & kChunkMask) << kChunkBits) |
+                                        ((c.z & kChunkMask) << (2 * kChunkBits)))];
+}
+
+void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacle, CacheChunk& out) const {
+  // One exact distance transform over the chunk grown by the search reach (separable squared
+  // distances: a binary pass along x, then lower envelopes along y and z, kept only for the
+  // chunk's own voxels) gives every centre what centre_search would, capped at reach^2 the same
+  // way: an obstacle that could lower a centre's value lies within the region. Cheaper than one
+  // cube search per centre once a few dozen centres of a chunk are asked for, which an edge's
+  // points 1 cm apart always do.
+  const int reach = reach_for(cache_cap_, grid_->resolution());
+  const int n = kChunkSize + 2 * reach;
+  const int32_t cap2 = reach * reach;
+  const VoxelKey o{chunk.x * kChunkSize - reach, chunk.y * kChunkSize - reach, chunk.z * kChunkSize - reach};
+  std::vector<uint8_t>& occ = fill_scratch_.occ;
+  occ.assign(static_cast<size_t>(n) * n * n, 0);
+  for_each_obstacle(
+      *grid_, o, {o.x + n - 1, o.y + n - 1, o.z + n - 1}, unknown_is_obstacle,
+      [](int32_t, int32_t) { return true; },
+      [&](int32_t x, int32_t y, int32_t z) {
+        occ[(static_cast<size_t>(z - o.z) * n + (y - o.y)) * n + (x - o.x)] = 1;
+        return true;
+      });
+  // gx[z][y][i]: squared x distance from the chunk's column i to the nearest obstacle of row (y, z).
+  std::vector<int32_t>& gx = fill_scratch_.gx;
+  gx.assign(static_cast<size_t>(n) * n * kChunkSize, cap2);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y) {
+      const uint8_t* row = &occ[(static_cast<size_t>(z) * n + y) * n];
+      int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
+      // Nearest obstacle at or left of each column, then at or right of it.
+      int last = -2 * n;
+      for (int x = 0; x < reach + kChunkSize; ++x) {
+        if (row[x]) last = x;
+        if (x >= reach) g[x - reach] = x - last;
+      }
+      int next = 3 * n;
+      for (int x = n - 1; x >= reach; --x) {
+        if (row[x]) next = x;
+        if (x < reach + kChunkSize) {
+          const int32_t d = std::min(g[x - reach], next - x);
+          g[x - reach] = std::min(cap2, d * d);
+        }
+      }
+    }
+  // gy[z][j][i]: min over y of gx + (y - y_j)^2.
+  std::vector<int32_t>& gy = fill_scratch_.gy;
+  gy.assign(static_cast<size_t>(n) * kChunkSize * kChunkSize, cap2);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y) {
+      const int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
+      for (int j = 0; j < kChunkSize; ++j) {
+        const int32_t dy = y - (reach + j), q = dy * dy;
+        if (q >= cap2) continue;
+        int32_t* out_row = &gy[(static_cast<size_t>(z) * kChunkSize + j) * kChunkSize];
+        for (int i = 0; i < kChunkSize; ++i) out_row[i] = std::min(out_row[i], g[i] + q);
+      }
+    }
+  // Along z, straight into the chunk's values.
+  const double res = grid_->resolution();
+  std::array<int32_t, kChunkVolume> best;
+  best.fill(cap2);
+  for (int z = 0; z < n; ++z) {
+    const int32_t* g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
+    for (int k = 0; k < kChunkSize; ++k) {
+      const int32_t dz = z - (reach + k), q = dz * dz;
+      if (q >= cap2) continue;
+      int32_t* b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
+      for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], g[i] + q);
+    }
+  }
+  for (int i = 0; i < kChunkVolume; ++i) out[i] = std::sqrt(static_cast<double>(best[i])) * res - 0.5 * res;
 }
 
 double CollisionChecker::centre_search(const VoxelKey& c, int reach, bool unknown_is_obstacle) const {

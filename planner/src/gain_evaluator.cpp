@@ -10,6 +10,10 @@
 
 namespace semx::planner {
 
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
 using mapper::VoxelKey;
 using mapper::VoxelState;
 
@@ -191,35 +195,35 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
   for (size_t ray = 0; ray < directions_.size(); ++ray) {
     const Eigen::Vector3d& d = directions_[ray];
     const int ray_bin = direction_bin_[ray];
-    // 3-D DDA (Amanatides & Woo) in voxel units, t in metres along the unit direction; the block
-    // pointer is looked up only when the walk enters another 16^3 block.
+    // 3-D DDA (Amanatides & Woo) in voxel units, t in metres along the unit direction. The state
+    // lives in scalars (an indexed t_max[] array stays in memory) and the voxel's index in its
+    // 16^3 block is stepped along, the block looked up only when the walk leaves it: 11 against
+    // 12-14 ns a step for the array form (semx-perf-planner --kernels), the same voxels in the
+    // same order.
     VoxelKey k = origin;
-    int step[3];
-    double t_max[3], t_delta[3];
-    for (int a = 0; a < 3; ++a) {
-      if (d[a] > 0) {
-        step[a] = 1;
-        t_max[a] = (k[a] + 1 - o[a]) * res / d[a];
-        t_delta[a] = res / d[a];
-      } else if (d[a] < 0) {
-        step[a] = -1;
-        t_max[a] = (k[a] - o[a]) * res / d[a];
-        t_delta[a] = -res / d[a];
-      } else {
-        step[a] = 0;
-        t_max[a] = t_delta[a] = std::numeric_limits<double>::infinity();
+    int sx = 0, sy = 0, sz = 0;
+    double tx = kInf, ty = kInf, tz = kInf, dtx = kInf, dty = kInf, dtz = kInf;
+    auto setup = [&](double dir, int32_t key, double org, int& st, double& tm, double& td) {
+      if (dir > 0) {
+        st = 1;
+        tm = (key + 1 - org) * res / dir;
+        td = res / dir;
+      } else if (dir < 0) {
+        st = -1;
+        tm = (key - org) * res / dir;
+        td = -res / dir;
       }
-    }
-    VoxelKey block = mapper::block_of(k);
-    const mapper::VoxelBlock* b = grid.find_block(block);
+    };
+    setup(d.x(), k.x, o.x(), sx, tx, dtx);
+    setup(d.y(), k.y, o.y(), sy, ty, dty);
+    setup(d.z(), k.z, o.z(), sz, tz, dtz);
+    int lx = k.x & mapper::kBlockMask, ly = k.y & mapper::kBlockMask, lz = k.z & mapper::kBlockMask;
+    const mapper::VoxelBlock* b = grid.find_block(mapper::block_of(k));
     for (;;) {
       ++steps;
-      const VoxelKey kb = mapper::block_of(k);
-      if (kb != block) {
-        block = kb;
-        b = grid.find_block(block);
-      }
-      const VoxelState s = b ? b->state[static_cast<size_t>(mapper::local_index(k))] : VoxelState::kUnknown;
+      const size_t li =
+          static_cast<size_t>(lx | (ly << mapper::kBlockBits) | (lz << (2 * mapper::kBlockBits)));
+      const VoxelState s = b ? b->state[li] : VoxelState::kUnknown;
       if (s == VoxelState::kOccupied) break;
       if (s == VoxelState::kUnknown) {
         const int dx = k.x - origin.x + hx_, dy = k.y - origin.y + hx_, dz = k.z - origin.z + hz_;
@@ -233,18 +237,15 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
             const Eigen::Vector3d c = km.center(k) - p;
             GainVoxel kind = GainVoxel::kUnknown;
             bool known_kind = false;
-            const int lx = k.x & mapper::kBlockMask, ly = k.y & mapper::kBlockMask,
-                      lz = k.z & mapper::kBlockMask;
             if (lx > 0 && ly > 0 && lz > 0 && lx < mapper::kBlockMask && ly < mapper::kBlockMask &&
                 lz < mapper::kBlockMask) {
               // All six neighbours are in this block: read them directly (an unallocated block is
               // all unknown, so its inner voxels are "normal").
               known_kind = true;
               if (b) {
-                const size_t i = static_cast<size_t>(mapper::local_index(k));
-                constexpr size_t dy = mapper::kBlockSize, dz = mapper::kBlockSize * mapper::kBlockSize;
-                const VoxelState n[6] = {b->state[i - 1],  b->state[i + 1],  b->state[i - dy],
-                                         b->state[i + dy], b->state[i - dz], b->state[i + dz]};
+                constexpr size_t dy1 = mapper::kBlockSize, dz1 = mapper::kBlockSize * mapper::kBlockSize;
+                const VoxelState n[6] = {b->state[li - 1],   b->state[li + 1],   b->state[li - dy1],
+                                         b->state[li + dy1], b->state[li - dz1], b->state[li + dz1]};
                 bool free = false, occupied = false;
                 for (const VoxelState v : n) {
                   free |= v == VoxelState::kFree;
@@ -253,7 +254,7 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
                 kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
               }
             }
-            if (in_sector(c) && !(ignored_ && ignored_->count(k)) &&
+            if (in_sector(c) && !(ignored_ && !ignored_->empty() && ignored_->count(k)) &&
                 (known_kind || classify(neighbour_reader, k, kind))) {
               const int bin = bin_near(c, ray_bin);
               add(g, bin, kind);
@@ -262,10 +263,37 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
           }
         }
       }
-      const int a = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
-      if (t_max[a] > reach) break;
-      k[a] += step[a];
-      t_max[a] += t_delta[a];
+      // The axis whose boundary comes first (ties go to z, then y). A branchless select measured
+      // slower here (12.5 against 11 ns a step, semx-perf-planner --kernels).
+      if (tx < ty) {
+        if (tx < tz) {
+          if (tx > reach) break;
+          k.x += sx;
+          tx += dtx;
+          lx += sx;
+        } else {
+          if (tz > reach) break;
+          k.z += sz;
+          tz += dtz;
+          lz += sz;
+        }
+      } else if (ty < tz) {
+        if (ty > reach) break;
+        k.y += sy;
+        ty += dty;
+        ly += sy;
+      } else {
+        if (tz > reach) break;
+        k.z += sz;
+        tz += dtz;
+        lz += sz;
+      }
+      if (((lx | ly | lz) & ~mapper::kBlockMask) != 0) {
+        lx &= mapper::kBlockMask;
+        ly &= mapper::kBlockMask;
+        lz &= mapper::kBlockMask;
+        b = grid.find_block(mapper::block_of(k));
+      }
     }
   }
   if (stats) {

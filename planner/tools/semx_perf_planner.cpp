@@ -4,10 +4,14 @@
 //
 //   semx-perf-planner [--world apartment|two_rooms|env1|env2|env3] [--planner NAME] [--samples N]
 //                     [--seed N] [--runs N] [--max-time S] [--set KEY=VALUE]... [--fit] [--verbose]
+//                     [--kernels]
 //
 // env1-3 (the simulator's shipped worlds, voxelised by its ground truth) need the simulator
 // library at build time. --fit prints the least-squares charge coefficients of the cycle's wall
-// time against the work counters (docs/planner.md, "Planning time").
+// time against the work counters (docs/planner.md, "Planning time"). --kernels times the cycle's
+// two hot kernels on the first run's final map (stop it early with --max-time for a map with
+// frontiers): a gain evaluation, and ESDF reads along edges with the chunked cache against one
+// cube search per voxel centre.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
@@ -19,8 +23,11 @@
 #include <vector>
 
 #include "semx/planner/charge_model.hpp"
+#include "semx/planner/collision_checker.hpp"
 #include "semx/planner/exploration_planner.hpp"
 #include "semx/planner/exploration_sim.hpp"
+#include "semx/planner/gain_evaluator.hpp"
+#include "semx/planner/rng.hpp"
 #include "semx/planner/synthetic_world.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
@@ -32,6 +39,7 @@
 
 using namespace semx::planner;
 using namespace semx::runtime;
+namespace mapper = semx::mapper;
 
 namespace {
 
@@ -48,6 +56,62 @@ double mean(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
   return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The kernels on one map, at points drawn from its free voxels (fixed seed).
+void time_kernels(const mapper::StateGrid& grid, const PlannerConfig& config) {
+  Rng rng(1);
+  const mapper::KeyBox box = grid.known_bounds();
+  const double res = grid.resolution();
+  std::vector<Eigen::Vector3d> points;
+  for (int tries = 0; tries < 200000 && points.size() < 400; ++tries) {
+    const Eigen::Vector3d p(rng.uniform(box.min.x * res, (box.max.x + 1) * res),
+                            rng.uniform(box.min.y * res, (box.max.y + 1) * res),
+                            rng.uniform(box.min.z * res, (box.max.z + 1) * res));
+    if (grid.state(p) == mapper::VoxelState::kFree) points.push_back(p);
+  }
+  if (points.empty()) {
+    std::printf("kernels: no free voxel to time at\n");
+    return;
+  }
+  GainEvaluator gains(config.gain);
+  GainStats stats;
+  auto t0 = std::chrono::steady_clock::now();
+  double total = 0;
+  for (const Eigen::Vector3d& p : points) total += gains.evaluate(grid, p, &stats).gain;
+  const double gain_ms = ms_since(t0);
+  std::printf("kernel_gain_evaluation: %.3f ms\n", gain_ms / static_cast<double>(points.size()));
+  std::printf("kernel_gain_ray_step: %.2f ns\n", 1e6 * gain_ms / static_cast<double>(stats.steps));
+  std::printf("kernel_gain_checksum: %.0f weighted voxels\n", total);
+  // Edges from each point towards the next, 2 m at most, read every centimetre as samples_free does
+  // where the coarse points fall short: a fresh checker each time (cold cache, as after new data).
+  const CollisionConfig& cc = config.collision;
+  // Just above the cache's cap (0.75 m with the defaults), the uncached path: the same 10-voxel
+  // search reach, one cube search per centre.
+  const double cached_cap = 0.6, search_cap = 0.76;
+  for (int mode = 0; mode < 2; ++mode) {
+    CollisionChecker checker(cc);
+    checker.set_grid(&grid);
+    int64_t reads = 0;
+    double sum = 0;
+    t0 = std::chrono::steady_clock::now();
+    for (size_t i = 0; i + 1 < points.size(); ++i) {
+      const Eigen::Vector3d a = points[i], d = points[i + 1] - a;
+      const double len = std::min(2.0, d.norm());
+      if (len < 1e-6) continue;
+      const Eigen::Vector3d u = d / d.norm();
+      for (double s = 0; s <= len; s += CollisionChecker::kFineStep, ++reads)
+        sum += std::min(0.6, checker.esdf(a + s * u, mode == 0 ? cached_cap : search_cap));
+    }
+    const double ms = ms_since(t0);
+    std::printf("kernel_esdf_%s: %.3f us per point (%lld points, checksum %.3f)\n",
+                mode == 0 ? "chunk_cache" : "cube_search", 1e3 * ms / static_cast<double>(reads),
+                static_cast<long long>(reads), sum);
+  }
 }
 
 std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resolution) {
@@ -81,7 +145,7 @@ int main(int argc, char** argv) {
     std::string world_name = "apartment", planner_name, config_file;
     int64_t samples = 0, seed = -1, runs = 1;
     double max_time = 900.0, semantic_weight = 0.0;
-    bool fit = false, verbose = false;
+    bool fit = false, verbose = false, kernels = false;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
@@ -96,7 +160,8 @@ int main(int argc, char** argv) {
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
         .flag("fit", "print least-squares charge coefficients", &fit)
-        .flag("verbose", "one line per cycle", &verbose);
+        .flag("verbose", "one line per cycle", &verbose)
+        .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels);
     if (!p.parse(argc, argv)) return 0;
     if (!planner_name.empty()) overrides.push_back("planner=" + planner_name);
     if (samples > 0) overrides.push_back("sampling.samples=" + std::to_string(samples));
@@ -131,6 +196,7 @@ int main(int argc, char** argv) {
               static_cast<long long>(s.counters.gain_evaluations), 1e3 * s.charged_s, s.reason.c_str());
         }
       });
+      if (kernels && run == 0) time_kernels(sim.known(), c);
       for (size_t i = 0; i < r.cycle_ms.size(); ++i) {
         const CycleCounters& k = r.counters[i];
         cycle_ms.push_back(r.cycle_ms[i]);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <set>
 
 #include "planner_test_util.hpp"
@@ -88,6 +89,74 @@ TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
   EXPECT_FALSE(c.node_free({3.1, 2.1, 1.2}));
 }
 
+// The cached ESDF (chunks filled by one distance transform each) against a brute-force nearest
+// obstacle over a cluttered map with unknown voxels and blocks never allocated, for both unknown
+// rules, and again after local changes reported through note_changes.
+TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
+  mapper::StateGrid g(0.1);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> coord(0, 29), state(0, 9);
+  fill(g, {0, 0, 0}, {29, 29, 19}, VoxelState::kFree);
+  for (int i = 0; i < 120; ++i) {
+    const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
+    g.set_state(k, state(rng) < 6 ? VoxelState::kOccupied : VoxelState::kUnknown);
+  }
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  auto brute = [&](const Eigen::Vector3d& p, bool unknown) {
+    // The mapper's definition at the 8 surrounding centres, interpolated.
+    const double r = g.resolution();
+    double v = 0.0;
+    const Eigen::Vector3d u = p / r - Eigen::Vector3d::Constant(0.5);
+    const Eigen::Vector3d fl = u.array().floor();
+    for (int corner = 0; corner < 8; ++corner) {
+      double w = 1.0;
+      mapper::VoxelKey k;
+      for (int i = 0; i < 3; ++i) {
+        const int bit = (corner >> i) & 1;
+        const double f = u[i] - fl[i];
+        w *= bit ? f : 1.0 - f;
+        k[i] = static_cast<int32_t>(fl[i]) + bit;
+      }
+      int64_t best = 1 << 30;
+      for (int32_t z = k.z - 12; z <= k.z + 12; ++z)
+        for (int32_t y = k.y - 12; y <= k.y + 12; ++y)
+          for (int32_t x = k.x - 12; x <= k.x + 12; ++x) {
+            const VoxelState s = g.state(mapper::VoxelKey{x, y, z});
+            if (s == VoxelState::kFree || (s == VoxelState::kUnknown && !unknown)) continue;
+            const int64_t dx = x - k.x, dy = y - k.y, dz = z - k.z;
+            best = std::min(best, dx * dx + dy * dy + dz * dz);
+          }
+      v += w * (std::sqrt(static_cast<double>(best)) * r - 0.5 * r);
+    }
+    return v;
+  };
+  std::uniform_real_distribution<double> pos(0.2, 2.8), height(0.2, 1.8);
+  const double cap = 0.6;
+  for (int round = 0; round < 2; ++round) {
+    for (int i = 0; i < 400; ++i) {
+      const Eigen::Vector3d p(pos(rng), pos(rng), height(rng));
+      for (bool unknown : {true, false}) {
+        const double want = brute(p, unknown), got = c.esdf(p, cap, unknown);
+        if (want < cap) {
+          EXPECT_NEAR(got, want, 1e-9) << p.transpose() << " unknown " << unknown;
+        } else {
+          EXPECT_GE(got, cap - 1e-9) << p.transpose();
+        }
+      }
+    }
+    // Clear a few obstacles, add others; tell the checker.
+    std::vector<mapper::VoxelChange> changes;
+    for (int i = 0; i < 30; ++i) {
+      const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
+      const VoxelState after = i % 2 ? VoxelState::kFree : VoxelState::kOccupied;
+      g.set_state(k, after);
+      changes.push_back({k, after});
+    }
+    c.note_changes(changes);
+  }
+}
+
 TEST(Collision, EdgesKeepTheClearanceAllAlong) {
   mapper::StateGrid g = known_room();
   CollisionChecker c(CollisionConfig{});
@@ -117,7 +186,7 @@ TEST(Collision, EdgesKeepTheClearanceAllAlong) {
   fill_m(h, {4, 0, 0}, {6, 4, 2.5}, VoxelState::kUnknown);
   c.set_grid(&h);
   EXPECT_FALSE(c.edge_free({1, 2, 1.2}, {3.75, 2, 1.2}));  // its end 0.25 m from unknown space
-  EXPECT_TRUE(c.edge_free({1, 2, 1.2}, {3.5, 2, 1.2}));   // 0.5 m
+  EXPECT_TRUE(c.edge_free({1, 2, 1.2}, {3.5, 2, 1.2}));    // 0.5 m
   EXPECT_TRUE(c.node_free({3.5, 2, 1.2}));
 }
 

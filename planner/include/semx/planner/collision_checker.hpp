@@ -69,6 +69,12 @@ class CollisionChecker {
   // values near them are dropped, the rest kept (any other change drops the whole cache).
   void note_changes(const std::vector<mapper::VoxelChange>& changes) const;
 
+  // Centre values are cached in chunks of kChunkSize^3 voxels, each filled at once.
+  static constexpr int kChunkBits = 3;
+  static constexpr int kChunkSize = 1 << kChunkBits;
+  static constexpr int kChunkMask = kChunkSize - 1;
+  static constexpr int kChunkVolume = kChunkSize * kChunkSize * kChunkSize;
+
   // Box checks made so far (for the planning-time charge); reset by the caller.
   int64_t box_checks() const { return box_checks_; }
   void reset_counters() const { box_checks_ = 0; }
@@ -90,6 +96,8 @@ class CollisionChecker {
   // The ESDF at one voxel centre (before trilinear interpolation), exact below cache_cap_ +
   // a voxel diagonal + half a voxel and a lower bound above; cached until the grid changes.
   double centre_value(const mapper::VoxelKey& c, bool unknown_is_obstacle) const;
+  using CacheChunk = std::array<double, kChunkVolume>;
+  void fill_chunk(const mapper::VoxelKey& chunk, bool unknown_is_obstacle, CacheChunk& out) const;
   // The same, uncached, searching `reach` voxels around c.
   double centre_search(const mapper::VoxelKey& c, int reach, bool unknown_is_obstacle) const;
   static int reach_for(double cap, double res);
@@ -101,8 +109,12 @@ class CollisionChecker {
   // them with their neighbours: caching the centres' values instead of searching around every
   // point made the cycle ~10x cheaper (semx-perf-planner). Keyed per unknown rule.
   double cache_cap_ = 0.0;
-  using CacheBlock = std::array<double, mapper::kBlockVolume>;  // NaN: not computed yet
-  mutable std::unordered_map<uint64_t, CacheBlock> centre_cache_[2];
+  mutable std::unordered_map<uint64_t, CacheChunk> centre_cache_[2];
+  struct FillScratch {
+    std::vector<uint8_t> occ;
+    std::vector<int32_t> gx, gy;
+  };
+  mutable FillScratch fill_scratch_;
   mutable const mapper::StateGrid* cache_grid_ = nullptr;
   mutable std::array<uint64_t, 4> cache_stamp_{};
 };
