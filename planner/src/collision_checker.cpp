@@ -86,6 +86,7 @@ void CollisionChecker::validate_cache() const {
   const std::array<uint64_t, 4> stamp = stamp_of(*grid_);
   if (cache_grid_ == grid_ && stamp == cache_stamp_) return;
   for (auto& c : centre_cache_) c.clear();
+  last_chunk_ = {};
   cache_grid_ = grid_;
   cache_stamp_ = stamp;
 }
@@ -98,29 +99,47 @@ int CollisionChecker::reach_for(double cap, double res) {
 
 void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& changes) const {
   if (!cache_grid_ || changes.empty()) return;
+  // A change at v alters the values of centres within `reach` of it: the chunks that hold any
+  // voxel of v ± reach. Per changed chunk, the bounding box of its changes grown by reach (3 or 4
+  // chunks per axis, not the 5 of a chunk's whole neighbourhood).
   const int reach = reach_for(cache_cap_, cache_grid_->resolution());
-  const int d = (reach + kChunkSize - 1) / kChunkSize;  // chunks a change reaches
-  std::unordered_map<uint64_t, bool> done;
+  std::unordered_map<uint64_t, std::pair<VoxelKey, VoxelKey>> boxes;
   for (const mapper::VoxelChange& c : changes) {
-    const VoxelKey b = chunk_of(c.key);
-    if (!done.emplace(pack(b), true).second) continue;
-    for (int z = -d; z <= d; ++z)
-      for (int y = -d; y <= d; ++y)
-        for (int x = -d; x <= d; ++x) {
-          const uint64_t k = pack({b.x + x, b.y + y, b.z + z});
+    auto [it, inserted] = boxes.try_emplace(pack(chunk_of(c.key)), c.key, c.key);
+    if (inserted) continue;
+    for (int i = 0; i < 3; ++i) {
+      it->second.first[i] = std::min(it->second.first[i], c.key[i]);
+      it->second.second[i] = std::max(it->second.second[i], c.key[i]);
+    }
+  }
+  for (const auto& [chunk, box] : boxes) {
+    const VoxelKey lo = chunk_of({box.first.x - reach, box.first.y - reach, box.first.z - reach});
+    const VoxelKey hi = chunk_of({box.second.x + reach, box.second.y + reach, box.second.z + reach});
+    for (int32_t z = lo.z; z <= hi.z; ++z)
+      for (int32_t y = lo.y; y <= hi.y; ++y)
+        for (int32_t x = lo.x; x <= hi.x; ++x) {
+          const uint64_t k = pack({x, y, z});
           centre_cache_[0].erase(k);
           centre_cache_[1].erase(k);
         }
   }
+  last_chunk_ = {};
   cache_stamp_ = stamp_of(*cache_grid_);  // what is left is true for the grid as it is now
 }
 
 double CollisionChecker::centre_value(const VoxelKey& c, bool unknown_is_obstacle) const {
   const VoxelKey chunk = chunk_of(c);
-  auto [it, inserted] = centre_cache_[unknown_is_obstacle ? 1 : 0].try_emplace(pack(chunk));
-  if (inserted) fill_chunk(chunk, unknown_is_obstacle, it->second);
-  return it->second[static_cast<size_t>((c.x & kChunkMask) | ((c.y & kChunkMask) << kChunkBits) |
-                                        ((c.z & kChunkMask) << (2 * kChunkBits)))];
+  const uint64_t key = pack(chunk);
+  LastChunk& last = last_chunk_[unknown_is_obstacle ? 1 : 0];
+  // Consecutive reads (the 8 corners of a point, the points of an edge) mostly share a chunk.
+  if (!last.values || last.key != key) {
+    auto [it, inserted] = centre_cache_[unknown_is_obstacle ? 1 : 0].try_emplace(key);
+    if (inserted) fill_chunk(chunk, unknown_is_obstacle, it->second);
+    last.key = key;
+    last.values = &it->second;
+  }
+  return (*last.values)[static_cast<size_t>((c.x & kChunkMask) | ((c.y & kChunkMask) << kChunkBits) |
+                                            ((c.z & kChunkMask) << (2 * kChunkBits)))];
 }
 
 void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacle, CacheChunk& out) const {
@@ -144,11 +163,16 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
         return true;
       });
   // gx[z][y][i]: squared x distance from the chunk's column i to the nearest obstacle of row (y, z).
+  // Rows and planes with nothing below the cap are skipped by the later passes.
   std::vector<int32_t>& gx = fill_scratch_.gx;
+  std::vector<uint8_t>& row_near = fill_scratch_.row_near;
   gx.assign(static_cast<size_t>(n) * n * kChunkSize, cap2);
+  row_near.assign(static_cast<size_t>(n) * n, 0);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y) {
       const uint8_t* row = &occ[(static_cast<size_t>(z) * n + y) * n];
+      if (std::find(row, row + n, uint8_t{1}) == row + n) continue;
+      row_near[static_cast<size_t>(z) * n + y] = 1;
       int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
       // Nearest obstacle at or left of each column, then at or right of it.
       int last = -2 * n;
@@ -167,9 +191,13 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
     }
   // gy[z][j][i]: min over y of gx + (y - y_j)^2.
   std::vector<int32_t>& gy = fill_scratch_.gy;
+  std::vector<uint8_t>& plane_near = fill_scratch_.plane_near;
   gy.assign(static_cast<size_t>(n) * kChunkSize * kChunkSize, cap2);
+  plane_near.assign(static_cast<size_t>(n), 0);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y) {
+      if (!row_near[static_cast<size_t>(z) * n + y]) continue;
+      plane_near[static_cast<size_t>(z)] = 1;
       const int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
       for (int j = 0; j < kChunkSize; ++j) {
         const int32_t dy = y - (reach + j), q = dy * dy;
@@ -183,6 +211,7 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   std::array<int32_t, kChunkVolume> best;
   best.fill(cap2);
   for (int z = 0; z < n; ++z) {
+    if (!plane_near[static_cast<size_t>(z)]) continue;
     const int32_t* g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
     for (int k = 0; k < kChunkSize; ++k) {
       const int32_t dz = z - (reach + k), q = dz * dz;

@@ -110,8 +110,21 @@ class CollisionChecker {
   // point made the cycle ~10x cheaper (semx-perf-planner). Keyed per unknown rule.
   double cache_cap_ = 0.0;
   mutable std::unordered_map<uint64_t, CacheChunk> centre_cache_[2];
+  // The chunk read last, per unknown rule: a pointer into centre_cache_ (stable until an erase
+  // or clear, which reset it); a copied checker starts without one, its cache being a copy.
+  struct LastChunk {
+    uint64_t key = 0;
+    const CacheChunk* values = nullptr;
+    LastChunk() = default;
+    LastChunk(const LastChunk&) {}
+    LastChunk& operator=(const LastChunk&) {
+      values = nullptr;
+      return *this;
+    }
+  };
+  mutable std::array<LastChunk, 2> last_chunk_{};
   struct FillScratch {
-    std::vector<uint8_t> occ;
+    std::vector<uint8_t> occ, row_near, plane_near;
     std::vector<int32_t> gx, gy;
   };
   mutable FillScratch fill_scratch_;
