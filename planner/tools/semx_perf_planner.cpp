@@ -82,11 +82,19 @@ void time_kernels(const mapper::StateGrid& grid, const PlannerConfig& config) {
   GainStats stats;
   auto t0 = std::chrono::steady_clock::now();
   double total = 0;
-  for (const Eigen::Vector3d& p : points) total += gains.evaluate(grid, p, &stats).gain;
+  int64_t counted = 0;
+  for (const Eigen::Vector3d& p : points) {
+    const NodeGain g = gains.evaluate(grid, p, &stats);
+    total += g.gain;
+    counted += g.total_voxels();
+  }
   const double gain_ms = ms_since(t0);
   std::printf("kernel_gain_evaluation: %.3f ms\n", gain_ms / static_cast<double>(points.size()));
   std::printf("kernel_gain_ray_step: %.2f ns\n", 1e6 * gain_ms / static_cast<double>(stats.steps));
   std::printf("kernel_gain_checksum: %.0f weighted voxels\n", total);
+  std::printf("kernel_gain_steps: %.0f voxels stepped, %.0f counted per evaluation\n",
+              static_cast<double>(stats.steps) / static_cast<double>(points.size()),
+              static_cast<double>(counted) / static_cast<double>(points.size()));
   // Edges from each point towards the next, 2 m at most, read every centimetre as samples_free does
   // where the coarse points fall short: a fresh checker each time (cold cache, as after new data).
   const CollisionConfig& cc = config.collision;

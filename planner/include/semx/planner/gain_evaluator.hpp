@@ -15,9 +15,11 @@
 // is that of its best window and its yaw is the window's centre.
 //
 // Rays: rays_azimuth × rays_elevation directions, evenly spread around the node and across the
-// vertical field of view, each walked voxel by voxel (3-D DDA) to max_range; each voxel counts at
-// most once per node. Rays sample the view: with the defaults (128 × 10) every voxel within about
-// 2 m is reached, farther ones in part, so U counts the distinct voxels the rays reach.
+// vertical field of view, each walked voxel by voxel (3-D DDA) to max_range from the centre of the
+// node's voxel (so the walks are computed once; the sector test and a voxel's azimuth bin use the
+// node's own position); each voxel counts at most once per node. Rays sample the view: with the
+// defaults (128 × 10) every voxel within about 2 m is reached, farther ones in part, so U counts
+// the distinct voxels the rays reach.
 // evaluate_exact() counts every visible voxel of the sector by enumeration (the reference of the
 // tests; far too slow for planning). Voxels in the ignored set (what a visited goal still counted
 // after the vehicle looked from it: unobservable, exploration_planner.hpp) count for nothing.
@@ -93,6 +95,8 @@ class GainEvaluator {
   // atan2 (cross products with the bins' boundary directions).
   int bin_near(const Eigen::Vector3d& offset, int guess) const;
   void add(NodeGain& g, int bin, GainVoxel kind) const;
+  // The rays' voxel lists and the scratch bitset for this resolution.
+  void prepare(double res);
 
   GainConfig config_;
   int window_ = 1;
@@ -100,6 +104,18 @@ class GainEvaluator {
   std::vector<Eigen::Vector3d> directions_;
   std::vector<int> direction_bin_;             // bin of each direction's azimuth
   std::vector<Eigen::Vector2d> bin_boundary_;  // unit vector at the start of each bin
+  // Each ray's voxels from the centre of the node's voxel, as offsets; ray r's at
+  // [ray_begin_[r], ray_begin_[r+1]).
+  struct RayStep {
+    int16_t dx, dy, dz, pad;
+  };
+  std::vector<RayStep> ray_steps_;
+  std::vector<uint32_t> ray_begin_;
+  // The blocks around the node's, looked up in this evaluation (block_stamp_ == stamp_).
+  std::vector<const mapper::VoxelBlock*> block_ptr_;
+  std::vector<uint32_t> block_stamp_;
+  uint32_t stamp_ = 0;
+  int block_lo_ = 0, block_lo_z_ = 0, block_n_ = 0;
   // Scratch: one bit per voxel of the box around the node, "already counted".
   std::vector<uint64_t> seen_;
   const std::unordered_set<mapper::VoxelKey>* ignored_ = nullptr;

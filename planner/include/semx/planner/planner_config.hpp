@@ -134,11 +134,11 @@ struct LoopConfig {
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").
 struct ChargeConfig {
-  double base_s = 5.0e-4;             // per cycle
-  double per_box_check_s = 2.0e-6;    // per vehicle-box collision check (nodes and edge samples)
-  double per_gain_node_s = 1.0e-5;    // per gain evaluation
-  double per_ray_step_s = 1.2e-8;     // per voxel stepped by a gain ray
-  double per_search_node_s = 2.0e-7;  // per node settled by the graph search
+  double base_s = 0.0;                // per cycle
+  double per_box_check_s = 5.0e-7;    // per vehicle-box collision check (nodes and edge samples)
+  double per_gain_node_s = 0.0;       // per gain evaluation
+  double per_ray_step_s = 7.0e-9;     // per voxel stepped by a gain ray
+  double per_search_node_s = 0.0;     // per node settled by the graph search
   double scale = 1.0;                 // multiplies everything (0: planning is free)
 };
 
