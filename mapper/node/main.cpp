@@ -52,9 +52,11 @@ int main(int argc, char** argv) {
     const auto& c = mapper.counters();
     const int64_t frames = mapper.mapper().frames_integrated();
     std::printf(
-        "semx-mapper: %lld frames integrated (%.2f ms each), %lld rejected, %lld malformed; seq %lld; "
+        "semx-mapper: %lld frames integrated (%.2f ms each), %lld skipped (frame_period_s %g s), %lld "
+        "rejected, %lld malformed; seq %lld; "
         "%lld ESDF recomputes (%.2f ms each); %lld snapshots, %lld checkpoints written\n",
         static_cast<long long>(frames), frames ? c.integrate_ms / static_cast<double>(frames) : 0.0,
+        static_cast<long long>(c.frames_skipped), mapper.mapper().config().integration.frame_period_s,
         static_cast<long long>(c.frames_rejected), static_cast<long long>(mapper.frames_malformed()),
         static_cast<long long>(mapper.mapper().seq()), static_cast<long long>(c.esdf_recomputes),
         c.esdf_recomputes ? c.esdf_ms / static_cast<double>(c.esdf_recomputes) : 0.0,

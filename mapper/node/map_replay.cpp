@@ -13,6 +13,7 @@
 
 #include "messages.hpp"
 #include "semx/mapper/map_export.hpp"
+#include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/lcm_schema.hpp"
 #include "semx/runtime/wire_validator.hpp"
 
@@ -93,6 +94,7 @@ ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
   if (!type) throw ReplayError("no .lcm layout for semx.depth_image_t");
   semx::depth_image_t msg;
   DecodedDepth decoded;
+  runtime::FrameGate gate(mapper.config().integration.frame_period_s);
   auto note = [&](const std::string& why) {
     if (r.first_error.empty()) r.first_error = why;
   };
@@ -123,6 +125,10 @@ ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
       note("event " + std::to_string(i) + ": decoder threw: " + ex.what());
       continue;
     }
+    if (!gate.due(msg.utime)) {
+      ++r.skipped;
+      continue;
+    }
     std::string why = decode_depth(msg, decoded);
     if (why.empty()) why = check_frame(decoded.frame());
     if (!why.empty()) {
@@ -138,6 +144,7 @@ ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
       note("event " + std::to_string(i) + ": " + fr.report.error);
       continue;
     }
+    gate.taken(msg.utime);
     ++r.integrated;
     if (r.first_utime < 0) r.first_utime = msg.utime;
     r.last_utime = std::max(r.last_utime, msg.utime);

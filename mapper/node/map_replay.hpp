@@ -46,13 +46,15 @@ struct ReplayReport {
   int64_t integrated = 0;
   int64_t rejected = 0;   // decoded frames the integrator refused (reason in first_error)
   int64_t malformed = 0;  // events that are not a valid depth_image_t or not a plausible frame
+  int64_t skipped = 0;    // not due (integration.frame_period_s), as the live mapper skips them
   std::string first_error;
   int64_t first_utime = -1;
   int64_t last_utime = -1;
   double integrate_s = 0.0;  // wall time spent in Mapper::integrate
 };
 
-// Integrates every frame of the log into `mapper`. Throws ReplayError (see scan_log).
+// Integrates the log's frames into `mapper`, one per integration.frame_period_s as the live node
+// does. Throws ReplayError (see scan_log).
 ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper);
 
 // Writes <dir>/map.ckpt (a checkpoint semx-mapper --checkpoint can start from), <dir>/map.bt

@@ -52,9 +52,16 @@ std::vector<uint8_t> encode(const T& m) {
 }  // namespace
 
 MapperNode::MapperNode(runtime::Node& node, const MapperConfig& config, MapperNodeOptions options)
-    : node_(node), mapper_(config), options_(std::move(options)) {
+    : node_(node), mapper_(config), options_(std::move(options)), gate_(config.integration.frame_period_s) {
   checkpoint_path_ = options_.checkpoint_path.empty() ? config.checkpoint.path : options_.checkpoint_path;
   restore_checkpoint();
+  // Frames that are not due are dropped from their bytes' utime, before the 0.6 MB image is
+  // validated and decoded.
+  node_.skip_unless(ch::CAMERA_DEPTH, [this](int64_t utime) {
+    if (gate_.due(utime)) return true;
+    ++counters_.frames_skipped;
+    return false;
+  });
   node_.subscribe<semx::depth_image_t>(
       ch::CAMERA_DEPTH, [this](const semx::depth_image_t& m) { on_depth(m); },
       [this](const semx::depth_image_t& m) { return accept_depth(m); });
@@ -131,6 +138,7 @@ bool MapperNode::pipelined() const {
 }
 
 void MapperNode::on_depth(const semx::depth_image_t& m) {
+  gate_.taken(m.utime);
   auto job = std::make_shared<Job>();
   job->now = have_time_ ? std::max(now_, m.utime) : m.utime;
   // Around the vehicle; before the first odometry, around the camera.

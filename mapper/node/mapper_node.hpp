@@ -43,6 +43,7 @@
 
 #include "messages.hpp"
 #include "semx/mapper/mapper.hpp"
+#include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/node.hpp"
 
 namespace semx::mapper {
@@ -63,6 +64,7 @@ class MapperNode {
   struct Counters {
     int64_t frames_received = 0;  // passed the subscription's checks (decoded, plausible)
     int64_t frames_rejected = 0;  // of which refused by the integrator (e.g. no range overlap)
+    int64_t frames_skipped = 0;   // not due (integration.frame_period_s): dropped unread
     int64_t updates = 0;
     int64_t esdfs = 0;
     int64_t snapshots = 0;
@@ -149,6 +151,7 @@ class MapperNode {
   std::string checkpoint_path_;
   std::string startup_note_;
   Counters counters_;
+  runtime::FrameGate gate_;
   DecodedDepth decoded_;  // written by accept_depth, read by on_depth right after
   std::optional<Eigen::Vector3d> vehicle_;
   int64_t now_ = 0;

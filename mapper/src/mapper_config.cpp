@@ -28,6 +28,7 @@ void load(runtime::ConfigMap& m, MapperConfig& c) {
   in.get("min_range", c.integration.min_range, 0.0, 100.0);
   in.get("max_range", c.integration.max_range, 0.05, 100.0);
   in.get("pixel_step", c.integration.pixel_step, 1, 16);
+  in.get("frame_period_s", c.integration.frame_period_s, 0.0, 3600.0);
   std::string mode = to_string(c.integration.mode);
   in.get_choice("mode", mode, {"exact", "bundled", "fast"});
   c.integration.mode =

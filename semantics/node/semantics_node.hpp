@@ -12,7 +12,7 @@
 
 #include "semx/runtime/node.hpp"
 #include "semx/semantics/config.hpp"
-#include "semx/semantics/frame_gate.hpp"
+#include "semx/runtime/frame_gate.hpp"
 #include "semx/semantics/pipeline.hpp"
 #include "semx/semantics/regions.hpp"
 
@@ -63,7 +63,7 @@ class SemanticsNode {
   runtime::Node node_;
   SemanticPipeline pipeline_;
   RegionPublisher publisher_;
-  FrameGate gate_;
+  runtime::FrameGate gate_;
   bool need_labels_, need_rgb_;
   std::map<int64_t, Pending> pending_;
   uint64_t arrivals_ = 0;

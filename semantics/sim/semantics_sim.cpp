@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "semx/semantics/frame_gate.hpp"
+#include "semx/runtime/frame_gate.hpp"
 #include "semx/semantics/pipeline.hpp"
 #include "semx/simulator/quadrotor.hpp"
 #include "semx/simulator/rasterizer.hpp"
@@ -181,7 +181,7 @@ AccuracyReport run_accuracy(const AccuracyOptions& opt, const SemanticsConfig& c
   const runtime::PinholeCamera camera;
   SemanticPipeline pipeline(config);
   // The node's frame rate (detector.frame_period_s), so the figures are those of semx-semantics.
-  FrameGate gate(config.detector.frame_period_s);
+  runtime::FrameGate gate(config.detector.frame_period_s);
   CameraFrame frame;
   std::vector<double> run_start(report.objects.size(), -1.0);
   std::vector<int> pixels(report.objects.size());

@@ -76,11 +76,18 @@ TestLog write_log(const std::string& name, const std::vector<test::RoomFrame>& f
   return t;
 }
 
+// Every frame integrated (the live mapper's integration.frame_period_s = 0).
+MapperConfig every_frame() {
+  MapperConfig c;
+  c.integration.frame_period_s = 0;
+  return c;
+}
+
 TEST(MapReplay, RebuildsTheMapOfTheLoggedFramesAndWritesItsFiles) {
   const auto cam = test::small_camera();
   const auto frames = test::room_frames(6, cam, 6);
   const TestLog log = write_log("good.lcmlog", frames, cam);
-  MapperConfig cfg;
+  MapperConfig cfg = every_frame();
   Mapper replayed(cfg);
   ReplayOptions o;
   o.log_path = log.path;
@@ -115,8 +122,28 @@ TEST(MapReplay, RebuildsTheMapOfTheLoggedFramesAndWritesItsFiles) {
   std::remove(log.path.c_str());
 }
 
+// With the default integration.frame_period_s (0.1 s) the replay integrates the frames the live
+// node would: of frames 33 ms apart, those at 0 and 99999 us (1 ms of slack), and so the same map.
+TEST(MapReplay, SkipsTheFramesTheLiveMapperSkips) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(6, cam, 6);
+  const TestLog log = write_log("gated.lcmlog", frames, cam);
+  Mapper replayed{MapperConfig{}};
+  ReplayOptions o;
+  o.log_path = log.path;
+  const ReplayReport r = replay_log(o, replayed);
+  EXPECT_EQ(r.integrated, 2);
+  EXPECT_EQ(r.integrated + r.skipped + r.malformed, r.depth_events);
+  EXPECT_EQ(r.last_utime, 3 * 33333);
+  Mapper live{MapperConfig{}};
+  live.integrate(DepthFrame::view(cam, frames[0].pose, frames[0].depth));
+  live.integrate(DepthFrame::view(cam, frames[3].pose, frames[3].depth));
+  EXPECT_TRUE(replayed.map().grid().same_states(live.map().grid()));
+  std::remove(log.path.c_str());
+}
+
 TEST(MapReplay, MissingForeignCorruptAndTruncatedLogs) {
-  Mapper m{MapperConfig{}};
+  Mapper m{every_frame()};
   ReplayOptions o;
   auto error_of = [&](const std::string& path) -> std::string {
     o.log_path = path;
@@ -175,7 +202,7 @@ TEST(MapReplay, MissingForeignCorruptAndTruncatedLogs) {
     const std::string path = temp_file("truncated.lcmlog");
     std::ofstream(path, std::ios::binary)
         .write(bytes.data(), static_cast<std::streamsize>(bytes.size() - 1000));
-    Mapper t{MapperConfig{}};
+    Mapper t{every_frame()};
     o.log_path = path;
     const ReplayReport r = replay_log(o, t);
     EXPECT_TRUE(r.layout.truncated);
@@ -227,9 +254,12 @@ TEST(MapReplay, ExecutableWritesTheFilesAndFailsClearly) {
   const TestLog log = write_log("exe.lcmlog", test::room_frames(3, cam, 3), cam);
   const std::string dir = temp_file("exe_out");
   fs::remove_all(dir);
-  RunResult r = run_program({kBin + "/semx-map-replay", log.path, "--out", dir, "--set", "resolution=0.2"});
+  RunResult r = run_program({kBin + "/semx-map-replay", log.path, "--out", dir, "--set", "resolution=0.2", "--set",
+                             "integration.frame_period_s=0"});
   EXPECT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("frames integrated 3, rejected 0, malformed 2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frames integrated 3, skipped 0 (frame_period_s), rejected 0, malformed 2"),
+            std::string::npos)
+      << r.output;
   EXPECT_TRUE(fs::exists(dir + "/map.ckpt"));
   EXPECT_TRUE(fs::exists(dir + "/map.bt"));
   EXPECT_TRUE(fs::exists(dir + "/map.pcd"));

@@ -41,6 +41,7 @@ MapperConfig small_config() {
   c.streaming.snapshot_period = 0;  // only on request, unless a test says otherwise
   c.streaming.stats_period = 1.0;
   c.streaming.esdf_period = 0;  // an ESDF after every frame, so each can be compared with a reference
+  c.integration.frame_period_s = 0;  // every frame integrated, unless a test says otherwise
   return c;
 }
 
@@ -398,6 +399,31 @@ TEST(MapperNode, DefaultEsdfPeriodSendsFiveEsdfsPerSecondOfFrames) {
   for (const auto& e : wire.all<semx::esdf_local_t>(ch::ESDF_LOCAL)) esdf_utimes.push_back(e.utime);
   EXPECT_EQ(esdf_utimes, (std::vector<int64_t>{0, 200000, 400000}));
   EXPECT_EQ(mn.counters().esdfs, 3);
+}
+
+// The default integration.frame_period_s (0.1 s of message time): of 30 Hz frames the first and
+// then one per 0.1 s are integrated (and get a MAP_UPDATE); the others are skipped unread.
+TEST(MapperNode, DefaultFramePeriodIntegratesTenFramesASecond) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(4, cam, 4);
+  MapperConfig cfg = small_config();
+  cfg.integration.frame_period_s = MapperConfig().integration.frame_period_s;
+  ASSERT_DOUBLE_EQ(cfg.integration.frame_period_s, 0.1);
+  runtime::Node node(memq_node());
+  Wire wire(node);
+  MapperNode mn(node, cfg);
+  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
+  for (int k = 0; k <= 15; ++k) {
+    const int64_t utime = (k * 100000 / 3 + 9999) / 10000 * 10000;  // 30 Hz on a 10 ms tick grid
+    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k % 4], utime));
+    node.drain();
+  }
+  std::vector<int64_t> integrated;
+  for (const auto& u : wire.all<semx::map_update_t>(ch::MAP_UPDATE)) integrated.push_back(u.utime);
+  EXPECT_EQ(integrated, (std::vector<int64_t>{0, 100000, 200000, 300000, 400000, 500000}));
+  EXPECT_EQ(mn.counters().frames_skipped, 10);
+  EXPECT_EQ(mn.frames_malformed(), 0);
 }
 
 // streaming.lockstep_delay (default 0.04 s): in LOCKSTEP a frame is integrated on the worker and

@@ -3,7 +3,7 @@
 // YAML layout (all keys optional; unknown keys are errors):
 //   resolution: 0.1
 //   occupancy:   { prob_hit, prob_miss, clamp_min, clamp_max, threshold, bounds_min, bounds_max }
-//   integration: { min_range, max_range, pixel_step, mode }
+//   integration: { min_range, max_range, pixel_step, frame_period_s, mode }
 //   esdf:        { enabled, window, max_distance, unknown_as_occupied }
 //   streaming:   { snapshot_period, stats_period, esdf_period, lockstep_delay }
 //   checkpoint:  { path, period }
@@ -38,6 +38,10 @@ struct IntegrationParams {
   double max_range = 5.0;
   // Integrate every pixel_step-th pixel in both directions (1 = the full frame).
   int pixel_step = 1;
+  // s of message time: at most one depth frame per this much is integrated (0 = every frame).
+  // The camera's 30 frames a second overlap almost entirely (3 cm apart at 1 m/s); 10 a second
+  // (a voxel apart) map the same space for a third of the work (docs/mapper.md, "Frame rate").
+  double frame_period_s = 0.1;
   // How rays are walked (depth_integrator.hpp; speed and agreement in docs/mapper.md):
   //   exact:   every pixel's ray, end to camera: OctoMap's insertPointCloud, voxel for voxel;
   //   bundled: one ray per end voxel and quadrant of it (default; 99.6-99.8 % agreement);

@@ -1,11 +1,12 @@
-// FrameGate: which frames the semantics node processes (detector.frame_period_s).
+// FrameGate: which frames a node processes (semantics detector.frame_period_s, mapper
+// integration.frame_period_s).
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "semx/semantics/frame_gate.hpp"
+#include "semx/runtime/frame_gate.hpp"
 
-using semx::semantics::FrameGate;
+using semx::runtime::FrameGate;
 
 namespace {
 

@@ -1,16 +1,16 @@
-// Which camera frames the semantics module processes: at most one per `detector.frame_period_s`
-// of message time (docs/semantics.md, "Frame rate").
+// Which camera frames a node processes: at most one per `period_s` of message time (the
+// semantics module's detector.frame_period_s, the mapper's integration.frame_period_s).
 //
-// Why: a frame costs ~4 ms of detection, lifting and tracking, and in LOCKSTEP every node acks
-// every tick, so processing all 30 frames a second was a large share of a run's wall time, while
-// objects are confirmed over half a second of views anyway (tracking.min_duration_s). The gate
-// decides from the frame's utime alone, before anything is decoded, so both parts of a capture
-// (depth and labels, same utime) get the same answer and a log replays identically.
+// Why: in LOCKSTEP every node acks every tick, so a node that processes all 30 frames a second
+// takes a large share of a run's wall time, while consecutive frames 33 ms apart add little (the
+// vehicle moves 3 cm at 1 m/s). The gate decides from the frame's utime alone, before anything
+// is decoded, so every part of one capture (depth, labels, RGB: same utime) gets the same answer
+// and a log replays identically.
 #pragma once
 
 #include <cstdint>
 
-namespace semx::semantics {
+namespace semx::runtime {
 
 class FrameGate {
  public:
@@ -33,4 +33,4 @@ class FrameGate {
   int64_t next_ = -1;  // due time of the next frame
 };
 
-}  // namespace semx::semantics
+}  // namespace semx::runtime

@@ -1,8 +1,8 @@
-#include "semx/semantics/frame_gate.hpp"
+#include "semx/runtime/frame_gate.hpp"
 
 #include <cmath>
 
-namespace semx::semantics {
+namespace semx::runtime {
 
 namespace {
 constexpr int64_t kSlackUs = 1000;
@@ -23,4 +23,4 @@ void FrameGate::taken(int64_t utime) {
   last_ = utime;
 }
 
-}  // namespace semx::semantics
+}  // namespace semx::runtime
