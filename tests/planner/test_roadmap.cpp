@@ -314,6 +314,52 @@ TEST(DepRoadmap, NarrowMappedDoorwayIsCrossed) {
   }
 }
 
+// A doorway mapped 7 voxels wide with a door leaf beside it on the far side (env3's bathroom):
+// only edges straight through its middle keep their clearance. A passage node drawn in it gets an
+// approach node on each side on that line, which joins the two rooms whatever nodes lie around.
+TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
+  DepFixture f;
+  fill_m(f.grid, {-0.05, -0.05, -0.05}, {8.05, 8.05, 2.55}, VoxelState::kOccupied);
+  fill_m(f.grid, {0.05, 0.05, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kFree);
+  fill_m(f.grid, {0.05, 3.95, 0.05}, {7.95, 4.05, 2.45}, VoxelState::kOccupied);  // the wall
+  fill_m(f.grid, {3.25, 3.95, 0.05}, {3.85, 4.05, 2.05}, VoxelState::kFree);      // 7 voxels free
+  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);  // the door leaf
+  f.frontiers.reset(f.grid);
+  CollisionChecker c(f.config.collision);
+  c.set_grid(&f.grid);
+  // Off the middle line, even a straight crossing fails; on it, it passes.
+  EXPECT_FALSE(c.edge_free({3.45, 3.0, 1.2}, {3.45, 5.0, 1.2}));
+  EXPECT_TRUE(c.edge_free({3.55, 3.0, 1.2}, {3.55, 5.0, 1.2}));
+
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
+  dep.plan(ctx);
+  // Nodes on the far side, none on the middle line: not reachable.
+  for (const Eigen::Vector3d& q : {Eigen::Vector3d(2.0, 6.0, 1.2), Eigen::Vector3d(5.0, 6.5, 1.2)})
+    ASSERT_GE(dep.try_insert(ctx, q), -1);
+  const int64_t passage = dep.try_insert(ctx, {3.5, 4.02, 1.15});
+  ASSERT_GE(passage, 0);
+  EXPECT_TRUE(dep.graph().node(passage).passage);
+  const Roadmap::Search s = dep.graph().shortest_paths(dep.root());
+  bool crossed = false;
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (n.alive && n.position.y() > 4.5 && s.reached(n.id)) crossed = true;
+  }
+  EXPECT_TRUE(crossed);
+  // The approach nodes are on the line through the middle, each side, with the full clearance.
+  int approaches = 0;
+  for (const RoadmapEdge& e : dep.graph().node(passage).edges) {
+    const Eigen::Vector3d& q = dep.graph().node(e.to).position;
+    if (std::abs(q.x() - dep.graph().node(passage).position.x()) < 1e-9) {
+      ++approaches;
+      EXPECT_TRUE(c.node_free(q));
+    }
+    EXPECT_TRUE(c.edge_free(dep.graph().node(passage).position, q));
+  }
+  EXPECT_EQ(approaches, 2);
+}
+
 TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {
   DepFixture f;
   corridor(f.grid);

@@ -55,6 +55,9 @@ class DepStrategy : public Strategy {
   int64_t insert_root(PlanContext& ctx);
   // Step 3 for one position: the new node's id, or -1 when it was not kept.
   int64_t try_insert(PlanContext& ctx, const Eigen::Vector3d& p);
+  // A passage node at p (id, or -1 when it connected to nothing yet) and an approach node on each
+  // side of its doorway, on the line straight through it; returns the passage node's id or -1.
+  int64_t add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, int64_t id);
   // Candidates between parts of the roadmap the root cannot reach and the nearest reachable
   // nodes (sampling.bridge_attempts per cycle).
   void bridge(PlanContext& ctx);
