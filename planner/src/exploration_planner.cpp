@@ -247,6 +247,10 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
       s << "better goal (node " << o.goal.node << " score " << o.goal.score << " vs node " << goal_.node
         << " " << *current << ")";
       why = s.str();
+      // The goal left behind waits blacklist_cycles before it can be chosen again: two goals
+      // whose scores each beat the other by the hysteresis once the vehicle turns toward it
+      // held an in-process env3 exploration switching every 1.5 s for 500 s.
+      strategy_->reject_goal(goal_, iteration_ + config_.loop.blacklist_cycles);
     }
   }
 

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "planner_test_util.hpp"
+#include "semx/planner/angles.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/roadmap.hpp"
@@ -358,6 +359,25 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
     EXPECT_TRUE(c.edge_free(dep.graph().node(passage).position, q));
   }
   EXPECT_EQ(approaches, 2);
+
+  // A path through the passage holds the direction of travel there and at the waypoints either
+  // side of it; the goal keeps its own yaw.
+  std::vector<int64_t> near_far;
+  for (const RoadmapEdge& e : dep.graph().node(passage).edges) {
+    if (std::abs(dep.graph().node(e.to).position.x() - dep.graph().node(passage).position.x()) < 1e-9)
+      near_far.push_back(e.to);
+  }
+  ASSERT_EQ(near_far.size(), 2u);
+  if (dep.graph().node(near_far[0]).position.y() > dep.graph().node(near_far[1]).position.y())
+    std::swap(near_far[0], near_far[1]);
+  const std::vector<int64_t> path = {dep.root(), near_far[0], passage, near_far[1], near_far[1]};
+  std::vector<Eigen::Vector3d> w;
+  for (int64_t id : path) w.push_back(dep.graph().node(id).position);
+  w.back() += Eigen::Vector3d(1.0, 1.0, 0.0);  // a goal beyond, off the line
+  std::vector<double> yaws = interpolate_yaws(w, 0.0, 1.0);
+  dep.hold_heading_through_doorways(path, w, yaws);
+  for (size_t i = 1; i <= 3; ++i) EXPECT_NEAR(yaws[i], kPi / 2, 1e-9) << i;  // +y, through the door
+  EXPECT_NEAR(yaws.back(), 1.0, 1e-9);
 }
 
 TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {

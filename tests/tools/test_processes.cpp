@@ -69,7 +69,7 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
   // can miss a datagram. The protocol (no tick before the previous one was acked) is checked on
   // what was logged, completeness within 10 %.
   std::vector<std::pair<int64_t, std::size_t>> ticks;  // new ticks and their log positions
-  std::map<int64_t, std::size_t> acked;                 // tick -> position of the monitor's first ack
+  std::map<int64_t, std::size_t> acked;                // tick -> position of the monitor's first ack
   std::set<std::string> status_nodes;
   std::size_t position = 0;
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
@@ -95,7 +95,10 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
   }
   ASSERT_GE(static_cast<int>(ticks.size()), kTicks * 9 / 10);
   EXPECT_GE(static_cast<int>(acked.size()), kTicks * 9 / 10);
-  EXPECT_EQ(ticks.back().first, kTicks - 1);
+  // The last ticks can be among the datagrams missed (the set ends, and the logger with it, right
+  // after the clock's last tick): the run reached its end within the same 10 %.
+  EXPECT_LE(ticks.back().first, kTicks - 1);
+  EXPECT_GE(ticks.back().first, kTicks - 1 - kTicks / 10);
   for (const auto& [tick, at] : ticks) {
     auto ack = acked.find(tick - 1);
     if (ack != acked.end()) {
@@ -160,13 +163,14 @@ TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
 TEST(Processes, HiddenOutputGoesToTheLogAndShowsWhenItFails) {
   const std::string dir = temp_path("launch-logs");
   const std::string set = temp_path("hidden.yaml");
-  std::ofstream(set) << "name: hidden\nlog_dir: " << dir
-                     << "\nprocesses:\n"
-                        "  - name: chatty\n    command: [/bin/sh, -c, \"echo secret-line; sleep 0.3; exit 4\"]\n"
-                        "    show: false\n"
-                        "  - name: quiet\n    command: [/bin/sh, -c, \"printf 'hidden%s' -ok\"]\n    show: false\n"
-                        "    required: false\n"
-                        "  - name: shown\n    command: [/bin/sh, -c, \"echo visible-line; sleep 5\"]\n";
+  std::ofstream(set)
+      << "name: hidden\nlog_dir: " << dir
+      << "\nprocesses:\n"
+         "  - name: chatty\n    command: [/bin/sh, -c, \"echo secret-line; sleep 0.3; exit 4\"]\n"
+         "    show: false\n"
+         "  - name: quiet\n    command: [/bin/sh, -c, \"printf 'hidden%s' -ok\"]\n    show: false\n"
+         "    required: false\n"
+         "  - name: shown\n    command: [/bin/sh, -c, \"echo visible-line; sleep 5\"]\n";
   const std::string out = temp_path("hidden.out");
   Process launcher({bin("semx-launch"), set, "--no-color"}, out);
   EXPECT_EQ(launcher.wait(20), 1);

@@ -58,6 +58,10 @@ class DepStrategy : public Strategy {
   // A passage node at p (id, or -1 when it connected to nothing yet) and an approach node on each
   // side of its doorway, on the line straight through it; returns the passage node's id or -1.
   int64_t add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, int64_t id);
+  // Sets the yaws at each passage node of a path and at the waypoints either side of it to the
+  // direction of travel through it.
+  void hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
+                                     std::vector<double>& yaws) const;
   // Candidates between parts of the roadmap the root cannot reach and the nearest reachable
   // nodes (sampling.bridge_attempts per cycle).
   void bridge(PlanContext& ctx);
