@@ -193,25 +193,35 @@ int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   ctx.counters->sample_ms += sample_watch.ms();
   if (!ok) return -1;
   Stopwatch connect_watch;
+  const std::vector<std::pair<int64_t, double>> links = free_links(ctx, p);
+  int64_t id = links.empty() ? -1 : add_linked_node(ctx, p, passage, links);
+  if (passage) id = add_approaches(ctx, p, id);
+  ctx.counters->connect_ms += connect_watch.ms();
+  return id;
+}
+
+std::vector<std::pair<int64_t, double>> DepStrategy::free_links(PlanContext& ctx, const Eigen::Vector3d& p,
+                                                                int64_t exclude) {
   std::vector<std::pair<int64_t, double>> links;
   for (int64_t id : graph_.nearest(p, config_.roadmap.k_nearest, config_.roadmap.max_edge_length)) {
+    if (id == exclude) continue;
     const Eigen::Vector3d& q = graph_.node(id).position;
     ++ctx.counters->edges_checked;
     const bool free = id == root_ ? checker_.root_edge_free(q, p) : checker_.edge_free(p, q);
     if (free) links.emplace_back(id, (q - p).norm());
   }
-  int64_t id = -1;
-  if (!links.empty()) {
-    id = graph_.add_node(p);
-    graph_.node(id).passage = passage;
-    for (const auto& [to, length] : links) {
-      graph_.add_edge(id, to, length);
-      ++ctx.counters->edges_added;
-    }
-    ++ctx.counters->nodes_added;
+  return links;
+}
+
+int64_t DepStrategy::add_linked_node(PlanContext& ctx, const Eigen::Vector3d& p, bool passage,
+                                     const std::vector<std::pair<int64_t, double>>& links) {
+  const int64_t id = graph_.add_node(p);
+  graph_.node(id).passage = passage;
+  ++ctx.counters->nodes_added;
+  for (const auto& [to, length] : links) {
+    graph_.add_edge(id, to, length);
+    ++ctx.counters->edges_added;
   }
-  if (passage) id = add_approaches(ctx, p, id);
-  ctx.counters->connect_ms += connect_watch.ms();
   return id;
 }
 
@@ -243,28 +253,11 @@ int64_t DepStrategy::add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, 
       ++ctx.counters->edges_checked;
       if (!checker_.node_free(q) || ctx.grid->state(q) != VoxelState::kFree || !checker_.edge_free(p, q))
         continue;
-      std::vector<std::pair<int64_t, double>> links;
-      for (int64_t n : graph_.nearest(q, config_.roadmap.k_nearest, config_.roadmap.max_edge_length)) {
-        if (n == id) continue;
-        const Eigen::Vector3d& r = graph_.node(n).position;
-        ++ctx.counters->edges_checked;
-        const bool free = n == root_ ? checker_.root_edge_free(r, q) : checker_.edge_free(q, r);
-        if (free) links.emplace_back(n, (r - q).norm());
-      }
+      std::vector<std::pair<int64_t, double>> links = free_links(ctx, q, id);
       if (links.empty() && id < 0) continue;  // an island of three nodes helps nobody
-      if (id < 0) {
-        id = graph_.add_node(p);
-        graph_.node(id).passage = true;
-        ++ctx.counters->nodes_added;
-      }
-      const int64_t a = graph_.add_node(q);
-      ++ctx.counters->nodes_added;
-      graph_.add_edge(a, id, length);
-      ++ctx.counters->edges_added;
-      for (const auto& [to, l] : links) {
-        graph_.add_edge(a, to, l);
-        ++ctx.counters->edges_added;
-      }
+      if (id < 0) id = add_linked_node(ctx, p, true, {});
+      links.insert(links.begin(), {id, length});
+      add_linked_node(ctx, q, false, links);
       break;  // one approach node per side
     }
   }

@@ -40,7 +40,7 @@ MapperConfig small_config() {
   c.esdf.window = {4.0, 4.0, 2.0};  // 40 x 40 x 20 voxels: fast, and still a real field
   c.streaming.snapshot_period = 0;  // only on request, unless a test says otherwise
   c.streaming.stats_period = 1.0;
-  c.streaming.esdf_period = 0;  // an ESDF after every frame, so each can be compared with a reference
+  c.streaming.esdf_period = 0;       // an ESDF after every frame, so each can be compared with a reference
   c.integration.frame_period_s = 0;  // every frame integrated, unless a test says otherwise
   return c;
 }
@@ -374,6 +374,19 @@ TEST(MapperNode, PeriodicSnapshotsFollowMessageTime) {
   EXPECT_EQ(wire.count(ch::MAP_STATS), 0);
 }
 
+// 0.5 s of 30 Hz frames on the simulator's 10 ms tick grid (utimes 0, 40000, 70000, 100000, ...),
+// each after an odometry message, cycling through `frames`.
+template <class Camera, class Frames>
+void publish_30hz_frames(runtime::Node& node, const Camera& cam, const Frames& frames) {
+  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
+  for (int k = 0; k <= 15; ++k) {
+    const int64_t utime = (k * 100000 / 3 + 9999) / 10000 * 10000;
+    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
+    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k % frames.size()], utime));
+    node.drain();
+  }
+}
+
 // The default streaming.esdf_period (0.2 s of message time): the first frame's ESDF at once, then
 // one with the first frame at or after each due time; the others get only their MAP_UPDATE.
 TEST(MapperNode, DefaultEsdfPeriodSendsFiveEsdfsPerSecondOfFrames) {
@@ -385,15 +398,7 @@ TEST(MapperNode, DefaultEsdfPeriodSendsFiveEsdfsPerSecondOfFrames) {
   runtime::Node node(memq_node());
   Wire wire(node);
   MapperNode mn(node, cfg);
-  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
-  // 30 Hz frames on the simulator's 10 ms tick grid, 0.5 s of them.
-  std::vector<int64_t> sent;
-  for (int k = 0; k <= 15; ++k) {
-    const int64_t utime = (k * 100000 / 3 + 9999) / 10000 * 10000;
-    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
-    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k % 4], utime));
-    node.drain();
-  }
+  publish_30hz_frames(node, cam, frames);
   EXPECT_EQ(wire.count(ch::MAP_UPDATE), 16);
   std::vector<int64_t> esdf_utimes;
   for (const auto& e : wire.all<semx::esdf_local_t>(ch::ESDF_LOCAL)) esdf_utimes.push_back(e.utime);
@@ -412,13 +417,7 @@ TEST(MapperNode, DefaultFramePeriodIntegratesTenFramesASecond) {
   runtime::Node node(memq_node());
   Wire wire(node);
   MapperNode mn(node, cfg);
-  const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
-  for (int k = 0; k <= 15; ++k) {
-    const int64_t utime = (k * 100000 / 3 + 9999) / 10000 * 10000;  // 30 Hz on a 10 ms tick grid
-    node.publish(ch::ODOMETRY, odometry_at(vehicle, utime));
-    node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k % 4], utime));
-    node.drain();
-  }
+  publish_30hz_frames(node, cam, frames);
   std::vector<int64_t> integrated;
   for (const auto& u : wire.all<semx::map_update_t>(ch::MAP_UPDATE)) integrated.push_back(u.utime);
   EXPECT_EQ(integrated, (std::vector<int64_t>{0, 100000, 200000, 300000, 400000, 500000}));

@@ -277,12 +277,18 @@ TEST(DepRoadmap, NodesAndEdgesAreCollisionFreeAndPersistAcrossCycles) {
 // clearance, and an unknown voxel below the lintel at one jamb (seen at a grazing angle). The
 // roadmap must still connect both rooms: passage nodes in the doorway, edges with the passage
 // clearance, and the candidates drawn between the unreachable room and the reachable one.
+// An 8 x 8 x 2.5 m room, known entirely, split at y = 4 by a wall with a doorway whose free voxel
+// centres span x0..x1 (up to 2.05 m high).
+void two_rooms_with_doorway(mapper::StateGrid& g, double x0, double x1) {
+  fill_m(g, {-0.05, -0.05, -0.05}, {8.05, 8.05, 2.55}, VoxelState::kOccupied);
+  fill_m(g, {0.05, 0.05, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kFree);
+  fill_m(g, {0.05, 3.95, 0.05}, {7.95, 4.05, 2.45}, VoxelState::kOccupied);  // the wall
+  fill_m(g, {x0, 3.95, 0.05}, {x1, 4.05, 2.05}, VoxelState::kFree);
+}
+
 TEST(DepRoadmap, NarrowMappedDoorwayIsCrossed) {
   DepFixture f;
-  fill_m(f.grid, {-0.05, -0.05, -0.05}, {8.05, 8.05, 2.55}, VoxelState::kOccupied);
-  fill_m(f.grid, {0.05, 0.05, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kFree);
-  fill_m(f.grid, {0.05, 3.95, 0.05}, {7.95, 4.05, 2.45}, VoxelState::kOccupied);  // the wall
-  fill_m(f.grid, {3.15, 3.95, 0.05}, {3.95, 4.05, 2.05}, VoxelState::kFree);      // 0.9 m free
+  two_rooms_with_doorway(f.grid, 3.15, 3.95);  // 0.9 m free
   f.grid.set_state(f.grid.keys().key(Eigen::Vector3d(3.95, 4.05, 1.95)), VoxelState::kUnknown);
   f.frontiers.reset(f.grid);
   CollisionChecker c(f.config.collision);
@@ -320,10 +326,7 @@ TEST(DepRoadmap, NarrowMappedDoorwayIsCrossed) {
 // approach node on each side on that line, which joins the two rooms whatever nodes lie around.
 TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   DepFixture f;
-  fill_m(f.grid, {-0.05, -0.05, -0.05}, {8.05, 8.05, 2.55}, VoxelState::kOccupied);
-  fill_m(f.grid, {0.05, 0.05, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kFree);
-  fill_m(f.grid, {0.05, 3.95, 0.05}, {7.95, 4.05, 2.45}, VoxelState::kOccupied);  // the wall
-  fill_m(f.grid, {3.25, 3.95, 0.05}, {3.85, 4.05, 2.05}, VoxelState::kFree);      // 7 voxels free
+  two_rooms_with_doorway(f.grid, 3.25, 3.85);                                     // 7 voxels free
   fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);  // the door leaf
   f.frontiers.reset(f.grid);
   CollisionChecker c(f.config.collision);

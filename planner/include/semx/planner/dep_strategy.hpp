@@ -55,6 +55,13 @@ class DepStrategy : public Strategy {
   int64_t insert_root(PlanContext& ctx);
   // Step 3 for one position: the new node's id, or -1 when it was not kept.
   int64_t try_insert(PlanContext& ctx, const Eigen::Vector3d& p);
+  // The k nearest nodes within max_edge_length (but `exclude`) that a collision-free edge joins
+  // to p, with the edges' lengths.
+  std::vector<std::pair<int64_t, double>> free_links(PlanContext& ctx, const Eigen::Vector3d& p,
+                                                     int64_t exclude = -1);
+  // Adds a node at p joined to `links`; returns its id.
+  int64_t add_linked_node(PlanContext& ctx, const Eigen::Vector3d& p, bool passage,
+                          const std::vector<std::pair<int64_t, double>>& links);
   // A passage node at p (id, or -1 when it connected to nothing yet) and an approach node on each
   // side of its doorway, on the line straight through it; returns the passage node's id or -1.
   int64_t add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, int64_t id);
