@@ -235,7 +235,9 @@ int64_t DepStrategy::add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, 
   constexpr int kHeadings = 16;
   constexpr double kLengths[] = {0.7, 0.9, 1.1};
   // The line through the doorway: the heading whose segment out to 0.6 m on both sides keeps the
-  // most clearance (a slanted one runs into a jamb).
+  // most clearance (a slanted one runs into a jamb). A doorway's clearance is far below the
+  // cache's cap, so reading at that cap ranks the headings exactly.
+  const double cap = checker_.cached_cap();
   double best = -1.0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
   for (int k = 0; k < kHeadings; ++k) {
@@ -243,7 +245,7 @@ int64_t DepStrategy::add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, 
     const Eigen::Vector3d u(std::cos(a), std::sin(a), 0.0);
     double v = 1.0;
     for (double t = 0.1; t <= 0.6 + 1e-9 && v > best; t += 0.1)
-      v = std::min({v, checker_.esdf(p + t * u, 1.0), checker_.esdf(p - t * u, 1.0)});
+      v = std::min({v, checker_.esdf(p + t * u, cap), checker_.esdf(p - t * u, cap)});
     if (v > best) best = v, axis = u;
   }
   if (best < config_.collision.door_clearance) return id;

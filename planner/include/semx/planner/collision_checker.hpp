@@ -53,6 +53,9 @@ class CollisionChecker {
   // minus half a voxel, at voxel centres; trilinear between them). Exact up to `cap`; above it a
   // lower bound >= cap. Never more than the controller reads, whose field ignores unknown space.
   double esdf(const Eigen::Vector3d& p, double cap, bool unknown_is_obstacle = true) const;
+  // The largest cap esdf() serves from its cache; a larger one searches around every corner
+  // (a cube of ~20k voxels at 1 m), which made one doorway's approach nodes cost ~1 ms.
+  double cached_cap() const { return cache_cap_; }
   // m: spacing of the edge points checked where the coarse (edge_step) points fall short.
   static constexpr double kFineStep = 0.01;
   // m: in doorways, ESDF distance kept from unknown voxels (the body's half width + 5 cm; the
