@@ -50,6 +50,7 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   k.get("accel_feedforward", c.tracking.accel_feedforward, 0.0, 10.0);
   k.get("yaw_feedforward", c.tracking.yaw_feedforward, 0.0, 10.0);
   k.get("max_command_speed", c.tracking.max_command_speed, 0.01, 50.0);
+  k.get("max_command_speed_z", c.tracking.max_command_speed_z, 0.01, 50.0);
 
   auto s = m.child("safety");
   s.get("check_horizon", c.safety.check_horizon, 0.0, 3600.0);

@@ -1,5 +1,7 @@
 #include "semx/controller/tracking_controller.hpp"
 
+#include <cmath>
+
 #include "semx/controller/angles.hpp"
 
 namespace semx::controller {
@@ -7,7 +9,12 @@ namespace semx::controller {
 Eigen::Vector3d TrackingController::limit(const Eigen::Vector3d& v) const {
   const double n = v.norm();
   if (!std::isfinite(n)) return Eigen::Vector3d::Zero();
-  return n > config_.max_command_speed ? Eigen::Vector3d(v * (config_.max_command_speed / n)) : v;
+  // One scale for both limits keeps the command's direction.
+  double s = 1.0;
+  if (n > config_.max_command_speed) s = config_.max_command_speed / n;
+  const double z = std::abs(v.z()) * s;
+  if (z > config_.max_command_speed_z) s *= config_.max_command_speed_z / z;
+  return v * s;
 }
 
 Command TrackingController::track(const TrajectoryPoint& ref, const VehicleState& vehicle) const {

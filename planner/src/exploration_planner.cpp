@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "semx/planner/angles.hpp"
@@ -52,7 +53,7 @@ void ExplorationPlanner::reset() {
   pending_ = Pending();
   last_status_ = StatusReport();
   unobservable_.clear();
-  arrived_utime_ = -1;
+  arrived_utime_ = short_since_ = -1;
   if (grid_) frontiers_.reset(*grid_);
   strategy_->on_map_reset();
 }
@@ -107,6 +108,16 @@ bool ExplorationPlanner::goal_reached(int64_t utime) {
   }
   if (arrived_utime_ < 0) arrived_utime_ = utime;
   return utime - arrived_utime_ >= static_cast<int64_t>(std::llround(config_.loop.dwell_s * 1e6));
+}
+
+bool ExplorationPlanner::held_short(int64_t utime) {
+  if (!controller_holding_ || !goal_.valid || !pose_ ||
+      (pose_->position - goal_.position).norm() <= config_.loop.goal_tolerance) {
+    short_since_ = -1;
+    return false;
+  }
+  if (short_since_ < 0) short_since_ = utime;
+  return utime - short_since_ >= static_cast<int64_t>(std::llround(config_.loop.short_hold_s * 1e6));
 }
 
 void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
@@ -197,6 +208,13 @@ ExplorationPlanner::Output ExplorationPlanner::tick(int64_t utime) {
   return out;
 }
 
+int64_t ExplorationPlanner::quiet_until(int64_t utime) const {
+  if (pending_.active) return pending_.ready_utime;
+  if (state_ == PlannerState::kDone) return std::numeric_limits<int64_t>::max();
+  if (!grid_ || !pose_ || next_cycle_utime_ < 0) return utime;
+  return next_cycle_utime_;
+}
+
 void ExplorationPlanner::run_cycle(int64_t utime) {
   Stopwatch total;
   CycleCounters c;
@@ -228,6 +246,10 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     } else if (path_blocked()) {
       need = true;
       why = "path blocked";
+    } else if (held_short(utime)) {
+      need = true;
+      why = "controller holds short of the goal";
+      strategy_->reject_goal(goal_, iteration_ + config_.loop.blacklist_cycles);
     }
   }
   controller_trigger_ = controller_rejected_ = false;
@@ -323,7 +345,7 @@ void ExplorationPlanner::release(Output& out, int64_t utime) {
     } else {
       goal_ = p.goal;  // invalid for a hold: the next cycle plans again
       controller_holding_ = false;
-      arrived_utime_ = -1;
+      arrived_utime_ = short_since_ = -1;
       PlannedPath path;
       path.plan_id = ++plan_id_;
       path.waypoints = p.goal.waypoints;

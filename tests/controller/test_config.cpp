@@ -40,6 +40,7 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(tracking.accel_feedforward);
   SAME(tracking.yaw_feedforward);
   SAME(tracking.max_command_speed);
+  SAME(tracking.max_command_speed_z);
   SAME(safety.check_horizon);
   SAME(safety.max_odometry_age);
   SAME(safety.max_esdf_age);

@@ -31,6 +31,16 @@ TEST(TrackingController, FeedForwardAndFeedbackTerms) {
   // Far off: the command is clamped, and always finite.
   v.position = Eigen::Vector3d(-50, 0, 0);
   EXPECT_NEAR(c.track(ref, v).velocity.norm(), cfg.max_command_speed, 1e-12);
+  // Far below: the climb is clamped to the vehicle's vertical limit, in the same direction.
+  v.position = Eigen::Vector3d(1.0, 0.3, -1.2);
+  const Eigen::Vector3d up = c.track(ref, v).velocity;
+  EXPECT_NEAR(up.z(), cfg.max_command_speed_z, 1e-12);
+  const Eigen::Vector3d raw = ref.velocity + cfg.accel_feedforward * ref.acceleration +
+                              cfg.position_gain * (ref.position - v.position) +
+                              cfg.velocity_gain * (ref.velocity - v.velocity);
+  EXPECT_NEAR(up.normalized().dot(raw.normalized()), 1.0, 1e-12);
+  EXPECT_NEAR(c.hold_at(Eigen::Vector3d(0, 0, 2.2), 0.0, v).velocity.z(), cfg.max_command_speed_z, 1e-12)
+      << "holding the end of a climb far above";
   EXPECT_EQ(TrackingController::hover(7.0).mode, Command::Mode::kHold);
   EXPECT_NEAR(TrackingController::hover(7.0).yaw, 7.0 - 2 * M_PI, 1e-12);
 }

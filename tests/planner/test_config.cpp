@@ -59,6 +59,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(loop.goal_tolerance);
   SAME(loop.yaw_tolerance);
   SAME(loop.dwell_s);
+  SAME(loop.short_hold_s);
   SAME(loop.hysteresis);
   SAME(loop.done_cycles);
   SAME(loop.max_recovery_cycles);

@@ -234,6 +234,28 @@ TEST(Planner, ReplansWhenTheControllerRejectsAndAvoidsThatGoal) {
   EXPECT_NE(p.last_status().reason.find("controller rejected"), std::string::npos) << p.last_status().reason;
 }
 
+TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
+  mapper::StateGrid g = corridor();
+  ExplorationPlanner p(test_config());
+  p.set_map(&g);
+  p.set_pose(pose({1, 2, 1.2}));
+  int64_t t = 0;
+  const auto first = first_path(p, 0, 2000000, &t);
+  ASSERT_TRUE(first);
+  const Goal unreachable = p.goal();
+  ASSERT_GT((unreachable.position - Eigen::Vector3d(1, 2, 1.2)).norm(), p.config().loop.goal_tolerance);
+  // The controller holds the path's end but the vehicle never left the start (its commands
+  // rejected): the goal is given up after short_hold_s, not waited for forever.
+  p.on_controller_status(ControllerState::kHolding, first->plan_id);
+  const int64_t hold = static_cast<int64_t>(p.config().loop.short_hold_s * 1e6);
+  EXPECT_FALSE(first_path(p, t + 10000, t + hold - 10000)) << "still waiting within short_hold_s";
+  const auto second = first_path(p, t + hold, t + hold + 2000000);
+  ASSERT_TRUE(second);
+  EXPECT_NE(p.last_status().reason.find("controller holds short of the goal"), std::string::npos)
+      << p.last_status().reason;
+  EXPECT_NE(p.goal().node, unreachable.node);
+}
+
 TEST(Planner, ReplansWhenThePathIsBlocked) {
   mapper::StateGrid g = corridor();
   ExplorationPlanner p(test_config());

@@ -69,6 +69,11 @@ struct TrackingConfig {
   double accel_feedforward = 0.3;  // s, × reference acceleration: the vehicle's velocity lag
   double yaw_feedforward = 0.5;    // s, × reference yaw rate: the vehicle's yaw-angle lag
   double max_command_speed = 1.5;  // m/s, norm of any velocity command
+  // m/s, |vertical| of any velocity command: the simulator's vehicle climbs at most 1 m/s and
+  // rejects (then hovers on) a command beyond 1.25 m/s. Without it, holding the end of a climb
+  // 1.2 m above the vehicle asked for 1.5 m/s up, every command was rejected, and the vehicle
+  // hovered there for the rest of the run (env3 seed 1, from 61 s).
+  double max_command_speed_z = 1.0;
 };
 
 struct SafetyConfig {

@@ -1,7 +1,7 @@
 // The trajectory follower's control law, for a vehicle that takes world velocity setpoints and
 // responds to them with a first-order lag τ (v̇ = (v_cmd - v)/τ, as the simulator does):
 //
-//   v_cmd = v_ref + τ_ff·a_ref + k_p·(p_ref - p) + k_v·(v_ref - v),   |v_cmd| <= max_command_speed
+//   v_cmd = v_ref + τ_ff·a_ref + k_p·(p_ref - p) + k_v·(v_ref - v),   |v_cmd| <= max_command_speed, |v_cmd.z| <= max_command_speed_z
 //
 // With τ_ff = τ the feed-forward makes the vehicle's velocity follow v_ref exactly, and the error
 // e = p_ref - p obeys τ·ë + (1 + k_v)·ė + k_p·e = 0: stable for any k_p > 0, k_v > -1, and with the

@@ -67,6 +67,9 @@ class ExplorationPlanner {
     std::optional<RoadmapView> roadmap;
   };
   Output tick(int64_t utime);
+  // The earliest message time at which tick() can output anything, whatever arrives before it
+  // (the next cycle or release; `utime` when that depends on what arrives).
+  int64_t quiet_until(int64_t utime) const;
   // A new episode: forget the roadmap, goal and state (the map is the caller's).
   void reset();
 
@@ -93,6 +96,8 @@ class ExplorationPlanner {
   void run_cycle(int64_t utime);
   void release(Output& out, int64_t utime);
   bool goal_reached(int64_t utime);
+  // The controller has held the path's end for short_hold_s with the vehicle away from the goal.
+  bool held_short(int64_t utime);
   // After a goal was reached: what the gain still counts in the camera's window from the pose is
   // unobservable from here (inside solids, in the camera's blind spots); gains stop counting it.
   void mark_unobservable(CycleCounters& c);
@@ -108,6 +113,7 @@ class ExplorationPlanner {
   GainEvaluator gains_;
   std::unordered_set<mapper::VoxelKey> unobservable_;
   int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
+  int64_t short_since_ = -1;    // since when the controller holds away from the goal
   Rng rng_;
   const mapper::StateGrid* grid_ = nullptr;
   std::optional<VehiclePose> pose_;

@@ -130,6 +130,10 @@ struct LoopConfig {
   // come back at once.
   int visited_cycles = 40;
   double max_start_offset = 0.6;  // m, a pending path whose start the vehicle left is dropped
+  // s the controller may HOLD the path's end with the vehicle farther than goal_tolerance from the
+  // goal before the goal is given up (and blacklisted): a vehicle that cannot get there (its
+  // commands rejected, a body that does not fit) would otherwise wait for it forever.
+  double short_hold_s = 3.0;
 };
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").
