@@ -70,6 +70,7 @@ MapperNode::MapperNode(runtime::Node& node, const MapperConfig& config, MapperNo
   node_.subscribe<semx::map_request_t>(
       ch::MAP_REQUEST, [this](const semx::map_request_t& m) { on_request(m); }, &accept_request);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  node_.on_quiet_until([this](int64_t utime) { return quiet_until(utime); });
 }
 
 MapperNode::~MapperNode() {
@@ -271,17 +272,36 @@ void MapperNode::on_tick(int64_t tick, int64_t utime) {
   }
   if (!have_time_ || utime > now_) now_ = utime;
   have_time_ = true;
+  // A request that came while this node had promised quiet waits for the promised tick.
+  const bool answer = request_pending_ && node_.may_publish();
   if (!in_flight_.empty()) {
     // Outputs that read the map describe the map of the last MAP_UPDATE sent: publish every
     // frame first. Otherwise only the frames whose delay has passed.
-    if (request_pending_ || periodic_due()) {
+    if (answer || periodic_due()) {
       flush_frames();
     } else {
       publish_done(utime - period_us(mapper_.config().streaming.lockstep_delay));
     }
   }
-  if (request_pending_) publish_snapshot();
+  if (answer) publish_snapshot();
   periodic();
+}
+
+int64_t MapperNode::quiet_until(int64_t utime) const {
+  if (request_pending_) return utime;
+  const StreamingParams& st = mapper_.config().streaming;
+  // A frame is published lockstep_delay after its utime (in its own handler when not pipelined).
+  const int64_t delay = pipelined() ? period_us(st.lockstep_delay) : 0;
+  const int64_t frame = gate_.next_due();
+  if (frame == std::numeric_limits<int64_t>::min()) return utime;
+  int64_t q = frame + delay;
+  if (!in_flight_.empty()) q = std::min(q, in_flight_.front()->frame.utime + delay);
+  for (const auto& [next, period] : {std::pair{next_snapshot_, st.snapshot_period}, {next_stats_, st.stats_period}}) {
+    if (period > 0) q = std::min(q, next < 0 ? utime : next);
+  }
+  const double cp = mapper_.config().checkpoint.period;
+  if (!checkpoint_path_.empty() && cp > 0) q = std::min(q, next_checkpoint_ < 0 ? utime : next_checkpoint_);
+  return q;
 }
 
 void MapperNode::poll_wall() {

@@ -136,6 +136,8 @@ class MapperNode {
   void finish(Job& job);   // counters, log lines, publication
   void publish_done(int64_t up_to_utime);  // in-flight frames with utime <= this, in order
   bool periodic_due() const;
+  // LOCKSTEP: the earliest message time of this node's next output (runtime::Node::on_quiet_until).
+  int64_t quiet_until(int64_t utime) const;
   void worker_loop();
   void on_odometry(const semx::odometry_t& m);
   void on_request(const semx::map_request_t& m);

@@ -1,5 +1,6 @@
 #include "planner_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -27,6 +28,12 @@ PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& conf
       },
       accept_controller_status);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  node_.on_quiet_until([this](int64_t utime) {
+    // A mirror out of sync may request a snapshot on any tick.
+    if (!map_->in_sync() || last_status_utime_ < 0) return utime;
+    const int64_t period = static_cast<int64_t>(std::llround(kStatusPeriodS * 1e6));
+    return std::min(planner_.quiet_until(utime), last_status_utime_ + period);
+  });
   node_.set_state(runtime::NodeState::kRunning,
                   std::string(to_string(planner_.kind())) + ": waiting for the map");
 }

@@ -1,5 +1,6 @@
 #include "semx/runtime/clock_server.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace semx::runtime {
@@ -11,10 +12,16 @@ ClockServer::ClockServer(ClockServerConfig config) : config_(std::move(config)) 
   }
 }
 
+bool ClockServer::satisfied(const std::string& node) const {
+  const auto it = acks_.find(node);
+  if (it == acks_.end()) return false;
+  return it->second.tick >= tick_ || current_utime() < it->second.quiet_until;
+}
+
 bool ClockServer::tick_complete() const {
   if (config_.mode != ClockMode::kLockstep) return true;
   for (const auto& n : config_.lockstep_nodes) {
-    if (!acked_.count(n)) return false;
+    if (!satisfied(n)) return false;
   }
   return true;
 }
@@ -38,7 +45,6 @@ std::optional<ClockTick> ClockServer::poll(double wall_s) {
   }
   if (due) {
     ++tick_;
-    acked_.clear();
     tick_sent_at_ = last_send_ = wall_s;
     return ClockTick{tick_, current_utime(), false};
   }
@@ -49,10 +55,15 @@ std::optional<ClockTick> ClockServer::poll(double wall_s) {
   return std::nullopt;
 }
 
-bool ClockServer::on_ack(const std::string& node, int64_t tick) {
-  if (tick != tick_ || config_.mode != ClockMode::kLockstep) return false;
+bool ClockServer::on_ack(const std::string& node, int64_t tick, int64_t quiet_until) {
+  if (config_.mode != ClockMode::kLockstep || tick > tick_ || tick < 0) return false;
+  NodeAcks& a = acks_[node];
+  // Acks of one node come in order; an older one (a resent tick acked again) says nothing new.
+  if (tick < a.tick) return false;
   const bool was_complete = tick_complete();
-  acked_.insert(node);
+  a.tick = tick;
+  const int64_t acked_utime = tick * config_.period_us;
+  a.quiet_until = std::min(quiet_until, acked_utime + config_.max_slack_us);
   return !was_complete && tick_complete();
 }
 
@@ -60,7 +71,7 @@ std::vector<std::string> ClockServer::waiting_for() const {
   std::vector<std::string> out;
   if (config_.mode != ClockMode::kLockstep) return out;
   for (const auto& n : config_.lockstep_nodes) {
-    if (!acked_.count(n)) out.push_back(n);
+    if (!satisfied(n)) out.push_back(n);
   }
   return out;
 }

@@ -1,6 +1,7 @@
 #include "semx/runtime/frame_gate.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace semx::runtime {
 
@@ -14,6 +15,11 @@ FrameGate::FrameGate(double period_s)
 bool FrameGate::due(int64_t utime) const {
   if (period_us_ <= 0 || last_ < 0 || utime < last_) return true;
   return utime >= next_ - kSlackUs;
+}
+
+int64_t FrameGate::next_due() const {
+  if (period_us_ <= 0 || last_ < 0) return std::numeric_limits<int64_t>::min();
+  return next_ - kSlackUs;
 }
 
 void FrameGate::taken(int64_t utime) {

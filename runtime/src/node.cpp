@@ -204,6 +204,14 @@ void Node::note_handler_error(const std::string& channel, const char* what) {
 }
 
 bool Node::publish_raw(const std::string& channel, const void* data, std::size_t size) {
+  if (quiet_until_ > 0 && !may_publish() && channel != channels::NODE_STATUS && channel != channels::SIM_ACK) {
+    ++early_publishes_;
+    if (worth_logging(early_publishes_)) {
+      std::cerr << options_.name << ": published " << channel << " at utime " << clock_.now_utime()
+                << ", before its promised quiet_until " << quiet_until_ << " (" << early_publishes_
+                << " so far): this lockstep run may not repeat\n";
+    }
+  }
   auto& c = outgoing_[channel];
   c.outgoing = true;
   if (lcm_->publish(channel, data, static_cast<unsigned int>(size)) != 0) {
@@ -220,15 +228,27 @@ bool Node::publish_raw(const std::string& channel, const void* data, std::size_t
 void Node::on_clock_message(const semx::clock_t& msg) {
   const auto decision = clock_.on_clock(msg.tick, msg.utime, static_cast<ClockMode>(msg.mode));
   if (decision.new_tick) {
+    if (msg.tick > 0 && msg.utime > 0) tick_period_us_ = msg.utime / msg.tick;
+    in_tick_ = true;
     for (auto& fn : tick_handlers_) fn(msg.tick, msg.utime);
+    in_tick_ = false;
   }
   if (decision.ack) {
     semx::ack_t ack;
     ack.utime = msg.utime;
     ack.node = options_.name;
     ack.tick = msg.tick;
+    ack.quiet_until = quiet_until_fn_ ? quiet_until_fn_(msg.utime) : 0;
     publish(channels::SIM_ACK, ack);
+    quiet_until_ = ack.quiet_until;
   }
+}
+
+bool Node::may_publish() const {
+  // A tick handler's output goes out before this tick's ack; a message handler's before the
+  // next tick's: either is on time when the clock waits for that ack.
+  const int64_t at = clock_.now_utime() + (in_tick_ ? 0 : tick_period_us_);
+  return at >= quiet_until_;
 }
 
 void Node::set_time(int64_t utime, int64_t tick) { clock_.on_clock(tick, utime, clock_.mode()); }

@@ -1,5 +1,8 @@
 #include "semantics_node.hpp"
 
+#include <algorithm>
+#include <limits>
+
 #include "semantics_messages.hpp"
 #include "semx/runtime/channels.hpp"
 
@@ -71,6 +74,14 @@ SemanticsNode::SemanticsNode(runtime::NodeOptions options, const SemanticsConfig
         accept_rgb);
   }
   node_.on_tick([this](int64_t, int64_t utime) { maybe_publish(utime); });
+  // Regions change only when a frame is processed, so nothing is published before the next frame
+  // the gate takes or the periodic repeat.
+  node_.on_quiet_until([this](int64_t utime) {
+    const int64_t frame = gate_.next_due();
+    const int64_t repeat = publisher_.next_repeat_utime();
+    if (frame == std::numeric_limits<int64_t>::min() || counters_.frames_processed == 0) return utime;
+    return repeat < 0 ? frame : std::min(frame, repeat);
+  });
   node_.set_state(runtime::NodeState::kRunning, "waiting for camera frames");
 }
 

@@ -65,6 +65,11 @@ bool RegionPublisher::due(const std::vector<Region>& regions, int64_t utime) {
   return true;
 }
 
+int64_t RegionPublisher::next_repeat_utime() const {
+  if (last_utime_ < 0) return -1;
+  return last_utime_ + static_cast<int64_t>(std::llround(config_.publish_period_s * 1e6));
+}
+
 void RegionPublisher::reset() {
   last_.clear();
   last_utime_ = -1;

@@ -24,7 +24,7 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     : sim_(sim), node_(node), options_(std::move(options)), server_(options_.clock) {
   node_.subscribe<semx::control_cmd_t>(
       ch::CONTROL_CMD, [this](const semx::control_cmd_t& m) { on_command(m); }, &well_formed);
-  node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) { server_.on_ack(a.node, a.tick); });
+  node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) { server_.on_ack(a.node, a.tick, a.quiet_until); });
   next_progress_s_ = options_.progress_every_s;
 }
 

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "semx/runtime/clock_server.hpp"
 #include "semx/runtime/sim_clock.hpp"
 
@@ -120,4 +122,50 @@ TEST(ClockServer, LockstepCanBeCappedToASpeed) {
   auto t = s.poll(10.005);
   ASSERT_TRUE(t);
   EXPECT_EQ(t->tick, 1);
+}
+
+TEST(ClockServer, APromiseOfQuietIsNotWaitedForUntilItsTime) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"controller", "planner"};
+  cfg.period_us = 10000;
+  cfg.max_slack_us = 50000;
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(0.0));
+  s.on_ack("controller", 0);
+  // Quiet until t = 30 ms: ticks 1 and 2 go on without the planner, tick 3 waits for it.
+  EXPECT_TRUE(s.on_ack("planner", 0, 30000));
+  for (int64_t k = 1; k <= 3; ++k) {
+    auto t = s.poll(0.0);
+    ASSERT_TRUE(t) << "tick " << k;
+    EXPECT_EQ(t->tick, k);
+    EXPECT_TRUE(s.on_ack("controller", k) || k == 3);
+  }
+  EXPECT_FALSE(s.poll(0.0)) << "tick 3 is the planner's";
+  EXPECT_EQ(s.waiting_for(), std::vector<std::string>{"planner"});
+  // Its acks of the ticks it skipped come late and in order; the one of tick 3 completes it.
+  EXPECT_FALSE(s.on_ack("planner", 1, 30000));
+  EXPECT_FALSE(s.on_ack("planner", 2, 30000));
+  EXPECT_TRUE(s.on_ack("planner", 3, 0));
+  ASSERT_TRUE(s.poll(0.0));
+  EXPECT_EQ(s.current_tick(), 4);
+  EXPECT_FALSE(s.poll(0.0)) << "no promise now: tick 4 waits for both";
+}
+
+TEST(ClockServer, APromiseCountsAtMostTheSlackAhead) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"evaluator"};
+  cfg.period_us = 10000;
+  cfg.max_slack_us = 20000;
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(0.0));
+  s.on_ack("evaluator", 0, std::numeric_limits<int64_t>::max());
+  ASSERT_TRUE(s.poll(0.0));  // tick 1
+  ASSERT_TRUE(s.poll(0.0));  // tick 2: tick 1 (10 ms) is within 0 + 20 ms
+  EXPECT_EQ(s.current_tick(), 2);
+  EXPECT_FALSE(s.poll(0.0)) << "tick 2 is as far as a node may fall behind";
+  EXPECT_FALSE(s.on_ack("evaluator", 5, 0)) << "an ack from the future does not count";
+  EXPECT_TRUE(s.on_ack("evaluator", 1, std::numeric_limits<int64_t>::max()));
+  EXPECT_TRUE(s.poll(0.0));
 }

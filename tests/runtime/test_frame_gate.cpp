@@ -2,6 +2,7 @@
 // integration.frame_period_s).
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <vector>
 
 #include "semx/runtime/frame_gate.hpp"
@@ -51,4 +52,14 @@ TEST(FrameGate, LateFramesRestartTheScheduleAndANewEpisodeIsDue) {
 TEST(FrameGate, PeriodZeroTakesEveryFrame) {
   FrameGate g(0.0);
   EXPECT_EQ(taken(g, {0, 1, 2, 33333}), (std::vector<int64_t>{0, 1, 2, 33333}));
+}
+
+TEST(FrameGate, NextDueIsTheEarliestFrameItWouldTake) {
+  FrameGate g(0.1);
+  EXPECT_EQ(g.next_due(), std::numeric_limits<int64_t>::min()) << "before the first frame, any";
+  for (int64_t taken_at : {0, 99999, 240000}) {
+    g.taken(taken_at);
+    // A node promises quiet until next_due(): no frame before it may be due.
+    for (int64_t t = taken_at; t < taken_at + 300000; t += 500) EXPECT_EQ(g.due(t), t >= g.next_due()) << t;
+  }
 }

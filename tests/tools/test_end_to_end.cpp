@@ -82,6 +82,10 @@ TEST(EndToEnd, DemoSetExploresAndWritesTheRunFolder) {
     ASSERT_TRUE(fs::exists(p)) << p;
     EXPECT_GT(fs::file_size(p), 0u) << p;
   }
+  // Every lockstep node kept its promise of quiet (the clock did not wait for it on those ticks).
+  for (const auto& e : fs::directory_iterator(a.dir + "/logs")) {
+    EXPECT_EQ(read_file(e.path().string()).find("before its promised quiet_until"), std::string::npos) << e.path();
+  }
   const YAML::Node m = YAML::LoadFile(a.dir + "/metrics.json");
   EXPECT_EQ(m["world"].as<std::string>(), "env1");
   EXPECT_EQ(m["planner"].as<std::string>(), "semantic-dep");

@@ -198,6 +198,21 @@ TEST(Processes, MissingProgramAndBadSetAreClearErrors) {
   Process bad({bin("semx-launch"), "no-such-set"}, out2);
   EXPECT_EQ(bad.wait(10), 2);
   EXPECT_NE(read_file(out2).find("no process set 'no-such-set'"), std::string::npos) << read_file(out2);
+
+  // --without leaves out an optional process, and names the problem otherwise.
+  const std::string two = temp_path("two.yaml");
+  std::ofstream(two) << "name: t\nprocesses:\n  - name: needed\n    command: [true]\n"
+                        "  - name: extra\n    command: [semx-does-not-exist]\n    required: false\n";
+  const std::string out3 = temp_path("without.out");
+  Process without({bin("semx-launch"), two, "--no-color", "--without", "extra"}, out3);
+  EXPECT_EQ(without.wait(10), 0) << read_file(out3);
+  EXPECT_EQ(read_file(out3).find("semx-does-not-exist"), std::string::npos) << read_file(out3);
+  for (const char* name : {"needed", "ghost"}) {
+    const std::string out4 = temp_path(std::string("without_") + name + ".out");
+    Process refused({bin("semx-launch"), two, "--without", name}, out4);
+    EXPECT_EQ(refused.wait(10), 2);
+    EXPECT_NE(read_file(out4).find(std::string("--without '") + name + "'"), std::string::npos) << read_file(out4);
+  }
 }
 
 TEST(Processes, NodeSurvivesHostileMessagesWithBoundedMemory) {

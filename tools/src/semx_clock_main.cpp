@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
     Node node(options);
     install_shutdown_handlers();
     node.subscribe<semx::ack_t>(semx::channels::SIM_ACK,
-                                [&](const semx::ack_t& a) { server.on_ack(a.node, a.tick); });
+                                [&](const semx::ack_t& a) { server.on_ack(a.node, a.tick, a.quiet_until); });
     node.set_state(NodeState::kRunning, mode);
     std::cout << "semx-clock: " << mode << ", " << period_ms << " ms/tick"
               << (cfg.mode == ClockMode::kLockstep ? ", waiting for " + nodes : "") << " on " << node.url()

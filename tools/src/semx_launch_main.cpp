@@ -1,6 +1,7 @@
 // semx-launch: starts a process set (tools/launch/*.yaml) and supervises it. See docs/launch.md.
 #include <unistd.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <filesystem>
@@ -34,7 +35,7 @@ std::string source_root() {
 int main(int argc, char** argv) {
   return run_main("semx-launch", [&] {
     std::string set_name, lcm_url, log_dir;
-    std::vector<std::string> arg_list;
+    std::vector<std::string> arg_list, without;
     double duration = 0, grace = 5;
     bool list = false, no_color = false;
     ArgParser p(
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
         "says, Ctrl-C stops everything. SET is a file or a name in tools/launch/ (without .yaml).");
     p.positional("SET", "the process set", &set_name)
         .repeated("arg", "NAME=VALUE", "set one of the set's args (see --list)", &arg_list)
+        .repeated("without", "NAME", "do not start process NAME (one the set marks required: false)", &without)
         .option("lcm-url", "URL", "LCM provider for every process (exported as LCM_DEFAULT_URL)", &lcm_url)
         .option("duration", "S", "stop the set after S wall seconds", &duration)
         .option("grace", "S", "seconds between SIGINT and SIGKILL when stopping (default 5)", &grace)
@@ -78,7 +80,14 @@ int main(int argc, char** argv) {
     o.grace_s = grace;
     o.log_dir = log_dir;
     o.color = !no_color && isatty(STDOUT_FILENO);
-    const LaunchSet set = load_launch_set(file, overrides, {{"root", root}, {"bin", o.bin_dir}});
+    LaunchSet set = load_launch_set(file, overrides, {{"root", root}, {"bin", o.bin_dir}});
+    for (const std::string& name : without) {
+      const auto it = std::find_if(set.processes.begin(), set.processes.end(),
+                                   [&](const ProcessSpec& proc) { return proc.name == name; });
+      if (it == set.processes.end()) throw ArgError("--without '" + name + "': the set has no such process");
+      if (it->required) throw ArgError("--without '" + name + "': the set needs it (required)");
+      set.processes.erase(it);
+    }
     if (list) {
       std::cout << set.name << ": " << set.description << "\nargs:\n";
       for (const auto& [k, v] : set.args) std::cout << "  " << k << " = " << v << "\n";

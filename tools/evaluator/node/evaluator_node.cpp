@@ -121,6 +121,11 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
     regions_ = std::move(regions);
   });
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  // It publishes nothing but its map client's requests: with the mirror in sync the clock need
+  // not wait for it (it ends the set from message time, wherever the clock is by then).
+  node_.on_quiet_until([this](int64_t utime) {
+    return map_.in_sync() ? std::numeric_limits<int64_t>::max() : utime;
+  });
   node_.set_state(runtime::NodeState::kRunning, "waiting for the simulation");
 }
 

@@ -25,6 +25,9 @@ class FrameGate {
   // time (so the average rate is exactly 1/period), or one period from now when it is later.
   void taken(int64_t utime);
   void reset() { last_ = next_ = -1; }
+  // The earliest utime a due frame can have from now on (while time does not go back); the
+  // lowest int64 when any frame would do.
+  int64_t next_due() const;
   int64_t period_us() const { return period_us_; }
 
  private:

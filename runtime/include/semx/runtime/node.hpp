@@ -108,6 +108,16 @@ class Node {
   }
   const SimClock& clock() const { return clock_; }
   int64_t now_utime() const { return clock_.now_utime(); }
+  // LOCKSTEP: asked after the tick handlers, before each ack: the earliest message time at which
+  // this node may publish again, whatever it receives meanwhile (its own schedule: next cycle,
+  // next frame the gate takes, next periodic output). Sent in SIM_ACK, so the clock does not wait
+  // for this node on the ticks before it. Without one (or <= the tick), every tick is waited for.
+  // A node must keep its promise: may_publish() says whether the current tick is past it.
+  void on_quiet_until(std::function<int64_t(int64_t utime)> fn) { quiet_until_fn_ = std::move(fn); }
+  bool may_publish() const;
+  // Publications on ticks this node had promised to be quiet (a broken promise makes a lockstep
+  // run depend on scheduling); NODE_STATUS and SIM_ACK do not count.
+  int64_t early_publishes() const { return early_publishes_; }
   // For the clock's source, which does not follow SIM_CLOCK: its own current time.
   void set_time(int64_t utime, int64_t tick);
 
@@ -151,6 +161,11 @@ class Node {
   std::map<std::string, std::function<bool(int64_t)>> skip_filters_;
   std::vector<uint8_t> encode_buffer_;
   std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;
+  std::function<int64_t(int64_t)> quiet_until_fn_;
+  int64_t quiet_until_ = 0;  // the promise sent with the last ack
+  int64_t tick_period_us_ = 0;
+  bool in_tick_ = false;
+  int64_t early_publishes_ = 0;
   SimClock clock_;
   NodeState state_ = NodeState::kStarting;
   std::string detail_;

@@ -48,6 +48,8 @@ class RegionPublisher {
   // True when `regions` differ from the last published set beyond the thresholds.
   bool changed(const std::vector<Region>& regions) const;
   int64_t published() const { return published_; }  // how many times due() said yes
+  // When due() says yes next for unchanged regions (the periodic repeat); -1 before the first.
+  int64_t next_repeat_utime() const;
   void reset();
 
  private:
