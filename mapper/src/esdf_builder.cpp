@@ -82,9 +82,11 @@ void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, floa
   const size_t total = plane * nz;
   for (size_t i = 0; i < total; ++i) out[i] = out[i] >= kLinearInfinity ? kEdtInfinity : out[i] * out[i];
 
-  // x: contiguous lines.
+  // x: contiguous lines. A line that is all sites is final (0 everywhere): the inside field
+  // (want = free) of a mostly free window is mostly such lines, and skipping them halves its cost.
   for (size_t line = 0; line < static_cast<size_t>(ny) * nz; ++line) {
     float* o = out + line * nx;
+    if (std::all_of(o, o + nx, [](float v) { return v == 0.0f; })) continue;
     edt_1d(o, nx, line_out.data(), env_v.data(), env_z.data());
     std::memcpy(o, line_out.data(), sizeof(float) * nx);
   }
@@ -92,12 +94,13 @@ void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, floa
   for (int z = 0; z < nz; ++z) {
     float* base = out + z * plane;
     for (int x = 0; x < nx; ++x) {
-      bool any = false;
+      bool any = false, positive = false;
       for (int y = 0; y < ny; ++y) {
         line_in[y] = base[x + static_cast<size_t>(nx) * y];
         any |= line_in[y] < kFiniteBelow;
+        positive |= line_in[y] > 0.0f;
       }
-      if (!any) continue;
+      if (!any || !positive) continue;  // all infinite, or all sites: nothing changes
       edt_1d(line_in.data(), ny, line_out.data(), env_v.data(), env_z.data());
       for (int y = 0; y < ny; ++y) base[x + static_cast<size_t>(nx) * y] = line_out[y];
     }
