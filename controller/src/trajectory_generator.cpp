@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "semx/controller/fallback.hpp"
@@ -80,6 +81,25 @@ PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vect
   return PositionSpline(std::move(q), dt);
 }
 
+double TrajectoryGenerator::deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline) {
+  if (polyline.empty()) return 0.0;
+  const double duration = curve.duration();
+  const int n = std::max(1, static_cast<int>(std::ceil(duration / kDeviationStep)));
+  double worst = 0.0;
+  for (int i = 0; i <= n; ++i) {
+    const Eigen::Vector3d p = curve.evaluate(duration * i / n, 0);
+    double best = (p - polyline.front()).squaredNorm();
+    for (size_t k = 0; k + 1 < polyline.size(); ++k) {
+      const Eigen::Vector3d d = polyline[k + 1] - polyline[k];
+      const double dd = d.squaredNorm();
+      const double t = dd > 0 ? std::clamp((p - polyline[k]).dot(d) / dd, 0.0, 1.0) : 0.0;
+      best = std::min(best, (polyline[k] + t * d - p).squaredNorm());
+    }
+    worst = std::max(worst, std::sqrt(best));
+  }
+  return worst;
+}
+
 GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d>& polyline,
                                                const std::vector<double>& yaws, const StartState& start,
                                                double max_speed, const DistanceField& field) const {
@@ -98,6 +118,10 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
                                            config_.clearance.bound() + config_.optimizer.target_margin);
     if (result.optimizer.failed) {
       why = "optimiser failed (" + result.optimizer.message + ")";
+    } else if (const double off = deviation(smooth.position, polyline); off > config_.trajectory.max_deviation) {
+      std::ostringstream s;
+      s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
+      why = s.str();
     } else if (finish(smooth, times, yaws, v_max, field, result)) {
       result.ok = true;
       result.trajectory = std::move(smooth);

@@ -25,6 +25,7 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(clearance.outside_is_obstacle);
   SAME(trajectory.knot_interval);
   SAME(trajectory.fallback_speed_factor);
+  SAME(trajectory.max_deviation);
   SAME(optimizer.max_iterations);
   SAME(optimizer.weight_smoothness);
   SAME(optimizer.weight_clearance);

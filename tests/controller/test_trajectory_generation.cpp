@@ -315,3 +315,30 @@ TEST(Fallback, StopsAtEveryWaypointWithinTheLimits) {
   EXPECT_LE(e.speed, 0.5 * (1 + 1e-9));
   EXPECT_LE(e.acceleration, 2.0 * (1 + 1e-9));
 }
+
+TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback) {
+  // deviation(): a curve on a line 0.3 m beside a straight path is 0.3 m from it.
+  PositionSpline::Points q;
+  for (int i = 0; i < 8; ++i) q.push_back(Eigen::Vector3d(0.5 * i, 0.3, 1.0));
+  EXPECT_NEAR(TrajectoryGenerator::deviation(PositionSpline(q, 0.25), {{0, 0, 1}, {4, 0, 1}}), 0.3, 1e-9);
+  EXPECT_NEAR(TrajectoryGenerator::deviation(PositionSpline(q, 0.25), {{0, 0.3, 1}, {4, 0.3, 1}}), 0.0, 1e-9);
+
+  // A corner at 1 m/s: the optimiser rounds it, well within max_deviation...
+  const std::vector<Eigen::Vector3d> corner = {{0, 0, 1}, {3, 0, 1}, {3, 3, 1}};
+  ControllerConfig cfg;
+  const GenerationResult smooth = TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]),
+                                                                    0.0, FreeField());
+  ASSERT_TRUE(smooth.ok) << smooth.reason;
+  EXPECT_TRUE(smooth.trajectory.optimized) << smooth.reason;
+  const double cut = TrajectoryGenerator::deviation(smooth.trajectory.position, corner);
+  EXPECT_GT(cut, 0.0);
+  EXPECT_LE(cut, cfg.trajectory.max_deviation);
+  // ... but not within a corridor narrower than its cut: then the fallback, on the path itself.
+  cfg.trajectory.max_deviation = 0.5 * cut;
+  const GenerationResult strict = TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]),
+                                                                    0.0, FreeField());
+  ASSERT_TRUE(strict.ok) << strict.reason;
+  EXPECT_FALSE(strict.trajectory.optimized);
+  EXPECT_NE(strict.reason.find("strays"), std::string::npos) << strict.reason;
+  EXPECT_LT(TrajectoryGenerator::deviation(strict.trajectory.position, corner), 1e-6);
+}

@@ -45,6 +45,15 @@ struct ClearanceConfig {
 struct TrajectoryConfig {
   double knot_interval = 0.25;         // s, of the uniform cubic B-spline (before time scaling)
   double fallback_speed_factor = 0.5;  // fallback cruise speed as a fraction of max_velocity
+  // m: an optimised trajectory that strays farther than this from the path goes to the fallback.
+  // The planner keeps the path 0.42 m from occupied and unknown voxels; the ESDF the trajectory is
+  // checked against sees occupied ones only (the camera never sees the vehicle's surroundings), so
+  // only near the path is the unknown space known to be clear: within 0.4 m the trajectory's centre
+  // never reaches an unknown voxel. 0.25 m sent the optimiser's ordinary corner cuts at 1 m/s to
+  // the half-speed fallback. A trajectory that left a path's
+  // sharp climb by 0.6 m, still moving down from the last path, hit the unmapped top of a sofa
+  // (env2, 30 samples, seed 1).
+  double max_deviation = 0.4;
 };
 
 struct OptimizerConfig {

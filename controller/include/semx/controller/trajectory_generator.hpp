@@ -54,6 +54,10 @@ class TrajectoryGenerator {
   // The rule a flown trajectory is held to on each new ESDF (bound = half_size + brake_margin).
   ClearanceRule flight_rule() const;
 
+  // The farthest the curve gets from the polyline (sampled every kDeviationStep of its time).
+  static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline);
+  static constexpr double kDeviationStep = 0.05;  // s
+
   // Speed limit for a path asking for `max_speed` (0 = none).
   double speed_limit(double max_speed) const;
 
