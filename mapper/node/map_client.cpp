@@ -117,7 +117,7 @@ void MapClient::apply_delta(const MapDelta& d) {
   }
   if (mirror_->apply(d) == MapMirror::DeltaResult::kApplied) {
     heard_ = true;
-    if (on_delta_) on_delta_(d);
+    if (on_delta_) on_delta_(mirror_->last_applied());
   }
 }
 

@@ -25,7 +25,15 @@ bool MapMirror::valid(const MapDelta& d) {
 }
 
 void MapMirror::apply_changes(const MapDelta& d) {
-  for (const VoxelChange& c : d.changes) grid_.set_state(c.key, c.state);
+  last_applied_.seq = d.seq;
+  last_applied_.utime = d.utime;
+  last_applied_.resolution = d.resolution;
+  last_applied_.changes.resize(d.changes.size());
+  for (size_t i = 0; i < d.changes.size(); ++i) {
+    const VoxelChange& c = d.changes[i];
+    last_applied_.changes[i] = {c.key, c.state, grid_.state(c.key)};
+    grid_.set_state(c.key, c.state);
+  }
   seq_ = d.seq;
   ++counters_.deltas_applied;
 }

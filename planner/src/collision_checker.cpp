@@ -103,25 +103,34 @@ void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& chan
   // voxel of v ± reach. Per changed chunk, the bounding box of its changes grown by reach (3 or 4
   // chunks per axis, not the 5 of a chunk's whole neighbourhood).
   const int reach = reach_for(cache_cap_, cache_grid_->resolution());
-  std::unordered_map<uint64_t, std::pair<VoxelKey, VoxelKey>> boxes;
-  for (const mapper::VoxelChange& c : changes) {
-    auto [it, inserted] = boxes.try_emplace(pack(chunk_of(c.key)), c.key, c.key);
-    if (inserted) continue;
-    for (int i = 0; i < 3; ++i) {
-      it->second.first[i] = std::min(it->second.first[i], c.key[i]);
-      it->second.second[i] = std::max(it->second.second[i], c.key[i]);
+  // Each cache sees its own obstacles: occupied voxels (rule 0) or everything not free (rule 1).
+  // A change that keeps a voxel on the same side for a rule (unknown -> occupied for rule 1,
+  // unknown -> free for rule 0: most changes at the edge of the known space) leaves that cache
+  // as it is. Without the previous state, both go.
+  auto matters = [](int rule, const mapper::VoxelChange& c) {
+    if (!c.previous) return true;
+    const VoxelState before = *c.previous, after = c.state;
+    return rule == 0 ? (before == VoxelState::kOccupied) != (after == VoxelState::kOccupied)
+                     : (before == VoxelState::kFree) != (after == VoxelState::kFree);
+  };
+  for (int rule = 0; rule < 2; ++rule) {
+    std::unordered_map<uint64_t, std::pair<VoxelKey, VoxelKey>> boxes;
+    for (const mapper::VoxelChange& c : changes) {
+      if (!matters(rule, c)) continue;
+      auto [it, inserted] = boxes.try_emplace(pack(chunk_of(c.key)), c.key, c.key);
+      if (inserted) continue;
+      for (int i = 0; i < 3; ++i) {
+        it->second.first[i] = std::min(it->second.first[i], c.key[i]);
+        it->second.second[i] = std::max(it->second.second[i], c.key[i]);
+      }
     }
-  }
-  for (const auto& [chunk, box] : boxes) {
-    const VoxelKey lo = chunk_of({box.first.x - reach, box.first.y - reach, box.first.z - reach});
-    const VoxelKey hi = chunk_of({box.second.x + reach, box.second.y + reach, box.second.z + reach});
-    for (int32_t z = lo.z; z <= hi.z; ++z)
-      for (int32_t y = lo.y; y <= hi.y; ++y)
-        for (int32_t x = lo.x; x <= hi.x; ++x) {
-          const uint64_t k = pack({x, y, z});
-          centre_cache_[0].erase(k);
-          centre_cache_[1].erase(k);
-        }
+    for (const auto& [chunk, box] : boxes) {
+      const VoxelKey lo = chunk_of({box.first.x - reach, box.first.y - reach, box.first.z - reach});
+      const VoxelKey hi = chunk_of({box.second.x + reach, box.second.y + reach, box.second.z + reach});
+      for (int32_t z = lo.z; z <= hi.z; ++z)
+        for (int32_t y = lo.y; y <= hi.y; ++y)
+          for (int32_t x = lo.x; x <= hi.x; ++x) centre_cache_[rule].erase(pack({x, y, z}));
+    }
   }
   last_chunk_ = {};
   cache_stamp_ = stamp_of(*cache_grid_);  // what is left is true for the grid as it is now

@@ -179,9 +179,10 @@ std::vector<mapper::VoxelChange> SyntheticWorld::observe(mapper::StateGrid& know
   const Eigen::Vector3d axis = R.col(2);
   std::vector<VoxelKey> keys;
   auto set = [&](const VoxelKey& k, VoxelState s) {
-    if (known.state(k) == s) return;
+    const VoxelState before = known.state(k);
+    if (before == s) return;
     known.set_state(k, s);
-    changes.push_back({k, s});
+    changes.push_back({k, s, before});
   };
   const int step = std::max(1, pixel_step);
   for (int v = step / 2; v < cam.height; v += step) {

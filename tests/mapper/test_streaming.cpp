@@ -84,9 +84,21 @@ TEST(Streaming, MirrorFollowsEveryDelta) {
   MapMirror mirror(0.1);
   for (const auto& f : test::room_frames(5, cam, 5)) {
     const FrameResult r = mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
+    std::vector<VoxelState> before;
+    for (const VoxelChange& c : r.delta.changes) before.push_back(mirror.grid().state(c.key));
     ASSERT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kApplied);
     ASSERT_EQ(mirror.seq(), mapper.seq());
     expect_same(mirror.grid(), mapper.map().grid());
+    // What it hands on: the same changes, each with the state it replaced.
+    const MapDelta& applied = mirror.last_applied();
+    EXPECT_EQ(applied.seq, r.delta.seq);
+    ASSERT_EQ(applied.changes.size(), r.delta.changes.size());
+    for (size_t i = 0; i < applied.changes.size(); ++i) {
+      EXPECT_EQ(applied.changes[i].key, r.delta.changes[i].key);
+      EXPECT_EQ(applied.changes[i].state, r.delta.changes[i].state);
+      ASSERT_TRUE(applied.changes[i].previous);
+      EXPECT_EQ(*applied.changes[i].previous, before[i]);
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <optional>
 #include <set>
 
 #include "planner_test_util.hpp"
@@ -134,7 +135,7 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
   };
   std::uniform_real_distribution<double> pos(0.2, 2.8), height(0.2, 1.8);
   const double cap = 0.6;
-  for (int round = 0; round < 2; ++round) {
+  for (int round = 0; round < 4; ++round) {
     for (int i = 0; i < 400; ++i) {
       const Eigen::Vector3d p(pos(rng), pos(rng), height(rng));
       for (bool unknown : {true, false}) {
@@ -146,13 +147,17 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
         }
       }
     }
-    // Clear a few obstacles, add others; tell the checker.
+    // Clear a few obstacles, add others, turn some unknown; tell the checker, after the first
+    // round with each change's previous state (the cache of a rule the change does not concern
+    // is kept, and must still be exact).
     std::vector<mapper::VoxelChange> changes;
     for (int i = 0; i < 30; ++i) {
       const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
-      const VoxelState after = i % 2 ? VoxelState::kFree : VoxelState::kOccupied;
+      const VoxelState after = static_cast<VoxelState>(i % 3);
+      const VoxelState before = g.state(k);
+      if (before == after) continue;
       g.set_state(k, after);
-      changes.push_back({k, after});
+      changes.push_back({k, after, round > 0 ? std::optional<VoxelState>(before) : std::nullopt});
     }
     c.note_changes(changes);
   }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "semx/mapper/voxel_key.hpp"
@@ -16,8 +17,16 @@
 namespace semx::mapper {
 
 struct VoxelChange {
+  VoxelChange() = default;
+  VoxelChange(const VoxelKey& k, VoxelState s, std::optional<VoxelState> before = std::nullopt)
+      : key(k), state(s), previous(before) {}
+
   VoxelKey key;
-  VoxelState state;  // the new state
+  VoxelState state = VoxelState::kUnknown;  // the new state
+  // The state before, where whoever applied the change knew it (MapMirror::last_applied(); not
+  // in MAP_UPDATE): lets a reader skip changes that cannot concern it, e.g. unknown -> free for
+  // a check that counts only occupied voxels.
+  std::optional<VoxelState> previous;
 };
 
 struct MapDelta {

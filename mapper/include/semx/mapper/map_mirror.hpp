@@ -37,6 +37,8 @@ class MapMirror {
   DeltaResult apply(const MapDelta& delta);
   SnapshotResult apply(const MapSnapshot& snapshot);
 
+  // The delta apply(delta) applied last, with each change's previous state filled in.
+  const MapDelta& last_applied() const { return last_applied_; }
   // Sequence of the last delta applied (0: the empty map, before any delta).
   int64_t seq() const { return seq_; }
   bool needs_snapshot() const { return needs_snapshot_; }
@@ -76,6 +78,7 @@ class MapMirror {
   void drain_buffer();
 
   StateGrid grid_;
+  MapDelta last_applied_;
   int64_t seq_ = 0;
   bool needs_snapshot_ = false;
   size_t max_buffered_;
