@@ -222,6 +222,15 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     std::string reason;
     out.goal = global_.select_goal(ctx, score, &reason, &out.unreachable_informative);
     if (!out.goal.valid) {
+      // Nothing cached is informative any more: grow the graph toward the frontier clusters (as
+      // AEP plans to its cached frontier points) as DEP recovers, half the draws around the
+      // vehicle to reach them, joined by the bridge, and look again.
+      // Without this the vehicle stopped in env2's first rooms (62 %) with doors still open.
+      global_.sample(ctx, 0.5, 2);
+      global_.bridge(ctx);
+      out.goal = global_.select_goal(ctx, score, &reason, &out.unreachable_informative);
+    }
+    if (!out.goal.valid) {
       std::ostringstream r;
       r << "local gain " << best_gain << " below g_zero " << a.g_zero << "; fallback: " << reason;
       out.reason = r.str();

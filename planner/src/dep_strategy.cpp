@@ -422,27 +422,9 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   process_map_changes(ctx);
   insert_root(ctx);
 
-  // Sampling around the vehicle and the frontier clusters.
-  std::vector<FrontierTracker::Cluster> clusters;
-  if (ctx.frontiers) clusters = ctx.frontiers->clusters(config_.sampling.min_cluster_voxels);
   // Recovering: half the draws around the vehicle (to reconnect it to the roadmap), half around
   // frontier clusters anywhere, and twice the attempts.
-  const double fraction = ctx.recovering ? 0.5 : config_.sampling.frontier_fraction;
-  const int64_t checks = static_cast<int64_t>(config_.sampling.samples) *
-                         config_.sampling.max_attempts_factor * (ctx.recovering ? 2 : 1);
-  const int64_t draws = checks * config_.sampling.max_draws_factor;
-  int64_t checked = 0;
-  int kept = 0;
-  for (int64_t i = 0; i < draws && checked < checks && kept < config_.sampling.samples; ++i) {
-    ++ctx.counters->samples_drawn;
-    Stopwatch w;
-    const Eigen::Vector3d p = sampler_.draw(*ctx.rng, ctx.pose.position, clusters, fraction);
-    const bool free = ctx.grid->state(p) == VoxelState::kFree;
-    ctx.counters->sample_ms += w.ms();
-    if (!free) continue;
-    ++checked;
-    if (try_insert(ctx, p) >= 0) ++kept;
-  }
+  sample(ctx, ctx.recovering ? 0.5 : config_.sampling.frontier_fraction, ctx.recovering ? 2 : 1);
   bridge(ctx);
 
   PlanOutcome out;
@@ -450,6 +432,26 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   ctx.counters->box_checks += checker_.box_checks();
   checker_.reset_counters();
   return out;
+}
+
+void DepStrategy::sample(PlanContext& ctx, double frontier_fraction, int attempts_scale) {
+  std::vector<FrontierTracker::Cluster> clusters;
+  if (ctx.frontiers) clusters = ctx.frontiers->clusters(config_.sampling.min_cluster_voxels);
+  const int64_t checks =
+      static_cast<int64_t>(config_.sampling.samples) * config_.sampling.max_attempts_factor * attempts_scale;
+  const int64_t draws = checks * config_.sampling.max_draws_factor;
+  int64_t checked = 0;
+  int kept = 0;
+  for (int64_t i = 0; i < draws && checked < checks && kept < config_.sampling.samples; ++i) {
+    ++ctx.counters->samples_drawn;
+    Stopwatch w;
+    const Eigen::Vector3d p = sampler_.draw(*ctx.rng, ctx.pose.position, clusters, frontier_fraction);
+    const bool free = ctx.grid->state(p) == VoxelState::kFree;
+    ctx.counters->sample_ms += w.ms();
+    if (!free) continue;
+    ++checked;
+    if (try_insert(ctx, p) >= 0) ++kept;
+  }
 }
 
 DepStrategy::ScoreFn DepStrategy::paper_score() const {

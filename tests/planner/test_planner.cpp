@@ -312,6 +312,23 @@ struct PathAudit {
   }
 };
 
+TEST(Planner, AepFallbackGrowsTowardFarFrontiers) {
+  // The corridor's frontier (x = 6.1) is beyond what AEP's local tree (0.5 m box around x = 1)
+  // can see with a 2 m sensor: no local gain, nothing cached; the fallback must sample around the
+  // frontier and fly there rather than declare the map done.
+  mapper::StateGrid g = corridor();
+  PlannerConfig c = test_config("aep");
+  c.aep.radius = 0.5;
+  c.gain.max_range = 2.0;
+  ExplorationPlanner p(c);
+  p.set_map(&g);
+  p.set_pose(pose({1, 2, 1.2}));
+  const auto path = first_path(p, 0, 5000000);
+  ASSERT_TRUE(path) << p.last_status().reason;
+  EXPECT_GT(path->waypoints.back().x(), 3.5) << p.last_status().reason;
+  EXPECT_NE(p.state(), PlannerState::kDone);
+}
+
 class Baselines : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(Baselines, ProduceValidPathsAndExploreWithoutCollisions) {

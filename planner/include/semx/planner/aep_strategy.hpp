@@ -8,7 +8,10 @@
 // evaluated and cached. A node's value is G(n)·exp(-λ·c(n)); when the best local value's gain
 // reaches aep.g_zero the vehicle flies the first edge of its branch (receding horizon).
 // Frontier fallback: otherwise the goal is the cached high-gain position with the best
-// G·exp(-λ·d) over a persistent graph (d its graph distance), and the whole path to it is flown.
+// G·exp(-λ·d) over a persistent graph (d its graph distance), and the whole path to it is flown;
+// when no cached position is informative any more, the graph first grows samples around the
+// frontier clusters (DEP's recovery sampling: half the draws there, half around the vehicle,
+// twice the attempts).
 // Simplifications: the global graph is DEP's roadmap fed with the tree nodes whose gain reaches
 // min_gain and with the vehicle's past poses (AEP keeps a separate kd-tree of frontier points and
 // plans to them on its RRG); the gain is DEP's yaw-binned one (AEP optimises yaw continuously

@@ -69,6 +69,9 @@ class DepStrategy : public Strategy {
   // direction of travel through it.
   void hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
                                      std::vector<double>& yaws) const;
+  // Step 3: up to sampling.samples new nodes from draws around the vehicle and the frontier
+  // clusters (`frontier_fraction` of them around clusters; `attempts_scale` x the checks).
+  void sample(PlanContext& ctx, double frontier_fraction, int attempts_scale);
   // Candidates between parts of the roadmap the root cannot reach and the nearest reachable
   // nodes (sampling.bridge_attempts per cycle).
   void bridge(PlanContext& ctx);
