@@ -1,13 +1,16 @@
 #include "planner_node.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include "planner_messages.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::planner {
+
+namespace {
+constexpr int64_t kStatusPeriodUs = static_cast<int64_t>(PlannerNode::kStatusPeriodS * 1e6);
+}  // namespace
 
 PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& config)
     : config_(config), node_(std::move(options)), planner_(config) {
@@ -31,8 +34,7 @@ PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& conf
   node_.on_quiet_until([this](int64_t utime) {
     // A mirror out of sync may request a snapshot on any tick.
     if (!map_->in_sync() || last_status_utime_ < 0) return utime;
-    const int64_t period = static_cast<int64_t>(std::llround(kStatusPeriodS * 1e6));
-    return std::min(planner_.quiet_until(utime), last_status_utime_ + period);
+    return std::min(planner_.quiet_until(utime), last_status_utime_ + kStatusPeriodUs);
   });
   node_.set_state(runtime::NodeState::kRunning,
                   std::string(to_string(planner_.kind())) + ": waiting for the map");
@@ -51,11 +53,10 @@ void PlannerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   ExplorationPlanner::Output out = planner_.tick(utime);
   if (out.path) node_.publish(semx::channels::PLAN_PATH, to_message(*out.path, utime));
   if (out.roadmap) node_.publish(semx::channels::ROADMAP, to_message(*out.roadmap, utime));
-  const int64_t period = static_cast<int64_t>(std::llround(kStatusPeriodS * 1e6));
   if (out.status) {
     node_.publish(semx::channels::PLANNER_STATUS, to_message(*out.status, utime));
     last_status_utime_ = utime;
-  } else if (last_status_utime_ >= 0 && utime - last_status_utime_ >= period) {
+  } else if (last_status_utime_ >= 0 && utime - last_status_utime_ >= kStatusPeriodUs) {
     node_.publish(semx::channels::PLANNER_STATUS, to_message(planner_.last_status(), utime));
     last_status_utime_ = utime;
   }

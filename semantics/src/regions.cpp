@@ -56,7 +56,7 @@ bool RegionPublisher::changed(const std::vector<Region>& regions) const {
 }
 
 bool RegionPublisher::due(const std::vector<Region>& regions, int64_t utime) {
-  const int64_t period = static_cast<int64_t>(std::llround(config_.publish_period_s * 1e6));
+  const int64_t period = period_us();
   const bool first = last_utime_ < 0 || utime < last_utime_;
   if (!first && !changed(regions) && utime - last_utime_ < period) return false;
   last_ = regions;
@@ -67,7 +67,11 @@ bool RegionPublisher::due(const std::vector<Region>& regions, int64_t utime) {
 
 int64_t RegionPublisher::next_repeat_utime() const {
   if (last_utime_ < 0) return -1;
-  return last_utime_ + static_cast<int64_t>(std::llround(config_.publish_period_s * 1e6));
+  return last_utime_ + period_us();
+}
+
+int64_t RegionPublisher::period_us() const {
+  return static_cast<int64_t>(std::llround(config_.publish_period_s * 1e6));
 }
 
 void RegionPublisher::reset() {

@@ -215,13 +215,22 @@ TEST(Planner, PlanningTimeIsChargedBeforeThePathGoesOut) {
   EXPECT_TRUE(r.tick(0).path);
 }
 
-TEST(Planner, ReplansWhenTheControllerRejectsAndAvoidsThatGoal) {
+// The planner on the corridor map with the vehicle at (1, 2, 1.2), after its first path (at t).
+struct CorridorStart {
   mapper::StateGrid g = corridor();
-  ExplorationPlanner p(test_config());
-  p.set_map(&g);
-  p.set_pose(pose({1, 2, 1.2}));
+  ExplorationPlanner p{test_config()};
   int64_t t = 0;
-  const auto first = first_path(p, 0, 2000000, &t);
+  std::optional<PlannedPath> first;
+  CorridorStart() {
+    p.set_map(&g);
+    p.set_pose(pose({1, 2, 1.2}));
+    first = first_path(p, 0, 2000000, &t);
+  }
+};
+
+TEST(Planner, ReplansWhenTheControllerRejectsAndAvoidsThatGoal) {
+  CorridorStart start;
+  auto& [g, p, t, first] = start;
   ASSERT_TRUE(first);
   const Goal rejected = p.goal();
   // A stale status about another plan changes nothing.
@@ -235,12 +244,8 @@ TEST(Planner, ReplansWhenTheControllerRejectsAndAvoidsThatGoal) {
 }
 
 TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
-  mapper::StateGrid g = corridor();
-  ExplorationPlanner p(test_config());
-  p.set_map(&g);
-  p.set_pose(pose({1, 2, 1.2}));
-  int64_t t = 0;
-  const auto first = first_path(p, 0, 2000000, &t);
+  CorridorStart start;
+  auto& [g, p, t, first] = start;
   ASSERT_TRUE(first);
   const Goal unreachable = p.goal();
   ASSERT_GT((unreachable.position - Eigen::Vector3d(1, 2, 1.2)).norm(), p.config().loop.goal_tolerance);
@@ -257,12 +262,8 @@ TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
 }
 
 TEST(Planner, ReplansWhenThePathIsBlocked) {
-  mapper::StateGrid g = corridor();
-  ExplorationPlanner p(test_config());
-  p.set_map(&g);
-  p.set_pose(pose({1, 2, 1.2}));
-  int64_t t = 0;
-  const auto first = first_path(p, 0, 2000000, &t);
+  CorridorStart start;
+  auto& [g, p, t, first] = start;
   ASSERT_TRUE(first);
   ASSERT_GE(first->waypoints.size(), 2u);
   // An obstacle appears on the last segment of the path.

@@ -10,7 +10,7 @@
 // which bounds how far behind a node falls (what its receive buffer must hold). Its outputs
 // still come before the ack of a waited tick, so every reader sees the same order: the run is
 // the one the fully waited clock gives, with the nodes that have nothing to say off the critical
-// path (a 90 s env3 run: docs/evaluation.md).
+// path (docs/runtime.md, "Promised quiet").
 #pragma once
 
 #include <cstdint>

@@ -53,6 +53,8 @@ class RegionPublisher {
   void reset();
 
  private:
+  int64_t period_us() const;
+
   RegionConfig config_;
   std::vector<Region> last_;
   int64_t last_utime_ = -1;
