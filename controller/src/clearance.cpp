@@ -3,7 +3,18 @@
 #include <algorithm>
 #include <cmath>
 
+namespace {
+// Below this |∇distance| (a ridge between obstacles, e.g. a doorway's centre line) the nearest
+// obstacle's direction is unknown and only `bound` applies.
+constexpr double kMinGradient = 0.5;
+}  // namespace
+
 namespace semx::controller {
+
+double footprint_reach(const Eigen::Vector3d& n, double yaw, double half_xy, double half_z) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return half_xy * (std::abs(c * n.x() + s * n.y()) + std::abs(-s * n.x() + c * n.y())) + half_z * std::abs(n.z());
+}
 
 ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceField& field, double t0,
                                 double t1, const ClearanceRule& rule) {
@@ -23,12 +34,14 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
     r.violation_distance = d;
   };
 
+  const bool footprint = rule.footprint_half_xy > 0.0 && !trajectory.yaw.empty();
   double start = 0.0;
   bool escaping = false;
   for (int i = 0; i <= n; ++i) {
     const double t = n == 0 ? t0 : t0 + span * i / n;
     const Eigen::Vector3d p = trajectory.position_at(t);
-    const double d = field.distance(p);
+    Eigen::Vector3d g;
+    const double d = field.distance(p, footprint ? &g : nullptr);
     ++r.samples;
     if (d < r.min_distance) {
       r.min_distance = d;
@@ -52,6 +65,14 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
         return r;
       }
     } else if (low < rule.bound) {
+      fail(t, p, d);
+      return r;
+    } else if (footprint && g.norm() > kMinGradient &&
+               low < footprint_reach(g.normalized(), trajectory.yaw.evaluate(t, 0)(0), rule.footprint_half_xy,
+                                     rule.footprint_half_z) +
+                         rule.footprint_margin) {
+      // The gradient points away from the nearest obstacle; the reach is symmetric.
+      r.footprint = true;
       fail(t, p, d);
       return r;
     }

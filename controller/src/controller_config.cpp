@@ -17,6 +17,9 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   cl.get("half_size", c.clearance.half_size, 0.0, 5.0);
   cl.get("margin", c.clearance.margin, 0.0, 5.0);
   cl.get("brake_margin", c.clearance.brake_margin, 0.0, 5.0);
+  cl.get("half_height", c.clearance.half_height, 0.0, 5.0);
+  cl.get("footprint_margin", c.clearance.footprint_margin, 0.0, 5.0);
+  cl.get("turned_body", c.clearance.turned_body);
   cl.get("check_spacing", c.clearance.check_spacing, 0.001, 0.5);
   cl.get("allow_escape", c.clearance.allow_escape);
   std::string outside = c.clearance.outside_is_obstacle ? "obstacle" : "free";

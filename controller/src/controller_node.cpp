@@ -61,6 +61,15 @@ void ControllerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   }
 }
 
+int ControllerNode::run() {
+  const int code = node_.run();
+  const ControllerCounters& c = controller_.counters();
+  std::cout << "semx-controller: paths " << c.paths << ", trajectories " << c.trajectories << " (optimised "
+            << c.optimized << ", fallback " << c.fallbacks << ": strayed " << c.fallback_strays << ", too close " << c.fallback_too_close << "), rejected " << c.rejected
+            << ", unsafe " << c.unsafe << ", brakes " << c.brakes << ", stale stops " << c.stale_stops << std::endl;
+  return code;
+}
+
 void ControllerNode::publish_status(const ControllerStatus& s, int64_t utime) {
   node_.publish(semx::channels::CONTROLLER_STATUS, to_message(s, utime));
   last_status_utime_ = utime;

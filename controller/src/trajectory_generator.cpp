@@ -15,7 +15,7 @@ namespace {
 std::string describe(const ClearanceReport& c) {
   std::ostringstream s;
   s.precision(3);
-  s << "distance " << c.violation_distance << " m at t = " << c.violation_time << " s ("
+  s << (c.footprint ? "the turned body's reach, " : "") << "distance " << c.violation_distance << " m at t = " << c.violation_time << " s ("
     << c.violation_point.x() << ", " << c.violation_point.y() << ", " << c.violation_point.z() << ")";
   return s.str();
 }
@@ -27,17 +27,22 @@ double TrajectoryGenerator::speed_limit(double max_speed) const {
   return max_speed > 0 ? std::min(v, max_speed) : v;
 }
 
-ClearanceRule TrajectoryGenerator::generation_rule() const {
+ClearanceRule TrajectoryGenerator::generation_rule(bool optimised) const {
   ClearanceRule r;
   r.bound = config_.clearance.bound();
   r.hard_bound = config_.clearance.half_size;
   r.spacing = config_.clearance.check_spacing;
   r.allow_escape = config_.clearance.allow_escape;
+  if (optimised && config_.clearance.turned_body) {
+    r.footprint_half_xy = config_.clearance.half_size;
+    r.footprint_half_z = config_.clearance.half_height;
+    r.footprint_margin = config_.clearance.footprint_margin;
+  }
   return r;
 }
 
 ClearanceRule TrajectoryGenerator::flight_rule() const {
-  ClearanceRule r = generation_rule();
+  ClearanceRule r = generation_rule(false);
   r.bound = config_.clearance.brake_bound();
   r.require_exit = false;  // a horizon may end before an escape does
   return r;
@@ -56,7 +61,8 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   std::vector<double> scaled(times);
   for (double& t : scaled) t *= k;
   add_yaw_profile(trajectory, scaled, yaws, config_.limits.max_yaw_rate);
-  result.clearance = check_clearance(trajectory, field, 0.0, trajectory.duration(), generation_rule());
+  result.clearance =
+      check_clearance(trajectory, field, 0.0, trajectory.duration(), generation_rule(trajectory.optimized));
   return result.clearance.ok;
 }
 
@@ -81,6 +87,23 @@ PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vect
   return PositionSpline(std::move(q), dt);
 }
 
+Eigen::Vector3d TrajectoryGenerator::nearest_on_path(const Eigen::Vector3d& p,
+                                                     const std::vector<Eigen::Vector3d>& polyline) {
+  Eigen::Vector3d best = polyline.front();
+  double best_sq = (p - best).squaredNorm();
+  for (size_t k = 0; k + 1 < polyline.size(); ++k) {
+    const Eigen::Vector3d d = polyline[k + 1] - polyline[k];
+    const double dd = d.squaredNorm();
+    const double t = dd > 0 ? std::clamp((p - polyline[k]).dot(d) / dd, 0.0, 1.0) : 0.0;
+    const Eigen::Vector3d q = polyline[k] + t * d;
+    if (const double sq = (q - p).squaredNorm(); sq < best_sq) {
+      best_sq = sq;
+      best = q;
+    }
+  }
+  return best;
+}
+
 double TrajectoryGenerator::deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline) {
   if (polyline.empty()) return 0.0;
   const double duration = curve.duration();
@@ -88,14 +111,7 @@ double TrajectoryGenerator::deviation(const PositionSpline& curve, const std::ve
   double worst = 0.0;
   for (int i = 0; i <= n; ++i) {
     const Eigen::Vector3d p = curve.evaluate(duration * i / n, 0);
-    double best = (p - polyline.front()).squaredNorm();
-    for (size_t k = 0; k + 1 < polyline.size(); ++k) {
-      const Eigen::Vector3d d = polyline[k + 1] - polyline[k];
-      const double dd = d.squaredNorm();
-      const double t = dd > 0 ? std::clamp((p - polyline[k]).dot(d) / dd, 0.0, 1.0) : 0.0;
-      best = std::min(best, (polyline[k] + t * d - p).squaredNorm());
-    }
-    worst = std::max(worst, std::sqrt(best));
+    worst = std::max(worst, (nearest_on_path(p, polyline) - p).norm());
   }
   return worst;
 }
@@ -118,19 +134,23 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
                                            config_.clearance.bound() + config_.optimizer.target_margin);
     if (result.optimizer.failed) {
       why = "optimiser failed (" + result.optimizer.message + ")";
+      result.cause = FallbackCause::kOptimizerFailed;
     } else if (const double off = deviation(smooth.position, polyline); off > config_.trajectory.max_deviation) {
       std::ostringstream s;
       s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
       why = s.str();
+      result.cause = FallbackCause::kStrays;
     } else if (finish(smooth, times, yaws, v_max, field, result)) {
       result.ok = true;
       result.trajectory = std::move(smooth);
       return result;
     } else {
       why = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
+      result.cause = FallbackCause::kTooClose;
     }
   } else {
     why = "optimiser disabled";
+    result.cause = FallbackCause::kOptimizerOff;
   }
 
   const double v_fallback = v_max * config_.trajectory.fallback_speed_factor;

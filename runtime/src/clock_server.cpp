@@ -55,7 +55,7 @@ std::optional<ClockTick> ClockServer::poll(double wall_s) {
   return std::nullopt;
 }
 
-bool ClockServer::on_ack(const std::string& node, int64_t tick, int64_t quiet_until) {
+bool ClockServer::on_ack(const std::string& node, int64_t tick, int64_t quiet_until, double wall_s) {
   if (config_.mode != ClockMode::kLockstep || tick > tick_ || tick < 0) return false;
   NodeAcks& a = acks_[node];
   // Acks of one node come in order; an older one (a resent tick acked again) says nothing new.
@@ -64,7 +64,9 @@ bool ClockServer::on_ack(const std::string& node, int64_t tick, int64_t quiet_un
   a.tick = tick;
   const int64_t acked_utime = tick * config_.period_us;
   a.quiet_until = std::min(quiet_until, acked_utime + config_.max_slack_us);
-  return !was_complete && tick_complete();
+  const bool completed = !was_complete && tick_complete();
+  if (completed && wall_s >= 0) waited_on_[node] += std::max(0.0, wall_s - tick_sent_at_);
+  return completed;
 }
 
 std::vector<std::string> ClockServer::waiting_for() const {

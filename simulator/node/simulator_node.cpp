@@ -4,8 +4,12 @@
 #include <semx/clock_t.hpp>
 #include <semx/sim_event_t.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "frame_messages.hpp"
 #include "semx/runtime/channels.hpp"
@@ -24,7 +28,9 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     : sim_(sim), node_(node), options_(std::move(options)), server_(options_.clock) {
   node_.subscribe<semx::control_cmd_t>(
       ch::CONTROL_CMD, [this](const semx::control_cmd_t& m) { on_command(m); }, &well_formed);
-  node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) { server_.on_ack(a.node, a.tick, a.quiet_until); });
+  node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) {
+    server_.on_ack(a.node, a.tick, a.quiet_until, wall_seconds());
+  });
   next_progress_s_ = options_.progress_every_s;
 }
 
@@ -94,6 +100,7 @@ bool SimulatorNode::poll(double wall_s) {
   if (auto t = server_.poll(wall_s)) {
     if (!t->resend) advance_to(t->utime);
     publish_clock(*t);
+    if (!t->resend) server_.mark_published(wall_seconds());
     const double sim_s = static_cast<double>(t->utime) * 1e-6;
     if (options_.progress_every_s > 0 && sim_s >= next_progress_s_) {
       const auto o = sim_.odometry();
@@ -129,6 +136,19 @@ int SimulatorNode::run() {
               "%lld commands rejected\n",
               sim_s, wall, sim_s / std::max(1e-9, wall), static_cast<long long>(frames_),
               static_cast<long long>(sim_.vehicle().collisions()), static_cast<long long>(rejected_));
+  if (lockstep && !server_.waited_on().empty()) {
+    // Whom the clock waited on: the node whose ack completed each tick, and for how long.
+    std::vector<std::pair<double, std::string>> w;
+    double total = 0;
+    for (const auto& [name, s] : server_.waited_on()) {
+      w.emplace_back(s, name);
+      total += s;
+    }
+    std::sort(w.rbegin(), w.rend());
+    std::printf("semx-simulator: lockstep: %.2f s of the %.2f s wall waiting for acks; completed by", total, wall);
+    for (const auto& [s, name] : w) std::printf(" %s %.2f s,", name.c_str(), s);
+    std::printf(" the rest in the simulator\n");
+  }
   return 0;
 }
 

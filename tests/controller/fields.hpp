@@ -55,6 +55,22 @@ class TubeField : public DistanceField {
   double top_;
 };
 
+// One vertical post (a door jamb's end seen from above): distance to the line x = c.x, y = c.y.
+class PostField : public DistanceField {
+ public:
+  explicit PostField(const Eigen::Vector2d& c) : c_(c) {}
+  double distance(const Eigen::Vector3d& p, Eigen::Vector3d* g = nullptr) const override {
+    const Eigen::Vector2d d = p.head<2>() - c_;
+    const double n = d.norm();
+    if (g) *g = n > 1e-12 ? Eigen::Vector3d(d.x() / n, d.y() / n, 0.0) : Eigen::Vector3d::Zero();
+    return n;
+  }
+  double lipschitz() const override { return 1.0; }
+
+ private:
+  Eigen::Vector2d c_;
+};
+
 // A grid sampled from any function at cell centres.
 template <class F>
 GridDistanceField sample_grid(F f, const Eigen::Vector3d& origin, double res, int nx, int ny, int nz,

@@ -25,6 +25,9 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(clearance.outside_is_obstacle);
   SAME(trajectory.knot_interval);
   SAME(trajectory.fallback_speed_factor);
+  SAME(clearance.half_height);
+  SAME(clearance.footprint_margin);
+  SAME(clearance.turned_body);
   SAME(trajectory.max_deviation);
   SAME(optimizer.max_iterations);
   SAME(optimizer.weight_smoothness);

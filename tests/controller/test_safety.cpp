@@ -56,6 +56,33 @@ TEST(Clearance, PadsTheBoundBetweenSamples) {
   EXPECT_TRUE(check_clearance(t, wider, 0, 1, rule).ok);
 }
 
+TEST(Clearance, TheTurnedBodyReachesFartherTowardAWallsEnd) {
+  // Passing a post (a wall's end seen from above) 0.34 m to the side: above the 0.32 m bound. Faced
+  // square to it the box reaches 0.25 m; turned by 45° its corner reaches 0.354 m, into the post.
+  EXPECT_NEAR(footprint_reach({0, 1, 0}, 0.0, 0.25, 0.15), 0.25, 1e-12);
+  EXPECT_NEAR(footprint_reach({0, 1, 0}, M_PI / 4, 0.25, 0.15), 0.25 * std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(footprint_reach({0, 0, -1}, 0.3, 0.25, 0.15), 0.15, 1e-12);
+  const PostField post(Eigen::Vector2d(2.0, 0.34));
+  const auto with_yaw = [](double yaw) {
+    Trajectory t = straight({0, 0, 1}, {4, 0, 1}, 4.0);
+    t.yaw = YawSpline(YawSpline::Points(t.position.control_points().size(), YawSpline::Point(yaw)),
+                      t.position.knot_interval());
+    return t;
+  };
+  ClearanceRule rule;
+  rule.bound = 0.32;
+  rule.hard_bound = 0.25;
+  EXPECT_TRUE(check_clearance(with_yaw(M_PI / 4), post, 0, 4, rule).ok) << "the bound alone";
+  rule.footprint_half_xy = 0.25;
+  rule.footprint_half_z = 0.15;
+  rule.footprint_margin = 0.0;
+  EXPECT_TRUE(check_clearance(with_yaw(0.0), post, 0, 4, rule).ok) << "a face toward the post";
+  const ClearanceReport turned = check_clearance(with_yaw(M_PI / 4), post, 0, 4, rule);
+  EXPECT_FALSE(turned.ok);
+  EXPECT_TRUE(turned.footprint);
+  EXPECT_NEAR(turned.violation_point.x(), 2.0, 0.15) << "where the corner meets the post";
+}
+
 TEST(Safety, BrakesOnAPredictedCollisionAndSaysWhy) {
   ControllerConfig cfg;
   auto free_field = boxes_field({});

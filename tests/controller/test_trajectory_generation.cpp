@@ -14,6 +14,7 @@
 using namespace semx::controller;
 using semx::controller::test::FreeField;
 using semx::controller::test::TubeField;
+using semx::controller::test::PostField;
 
 namespace {
 
@@ -341,4 +342,32 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback
   EXPECT_FALSE(strict.trajectory.optimized);
   EXPECT_NE(strict.reason.find("strays"), std::string::npos) << strict.reason;
   EXPECT_LT(TrajectoryGenerator::deviation(strict.trajectory.position, corner), 1e-6);
+}
+
+TEST(TrajectoryGeneration, OnlyOptimisedCurvesAnswerForTheTurnedBody) {
+  // The fallback is the planner's own path (in a doorway, 0.35 m from the jambs in the ESDF, where
+  // a body heading diagonally still fits the world): it and the brake check keep the plain bounds.
+  ControllerConfig cfg;
+  const TrajectoryGenerator gen(cfg);
+  EXPECT_EQ(gen.generation_rule(true).footprint_half_xy, cfg.clearance.half_size);
+  EXPECT_EQ(gen.generation_rule(true).footprint_half_z, cfg.clearance.half_height);
+  EXPECT_EQ(gen.generation_rule(true).footprint_margin, cfg.clearance.footprint_margin);
+  EXPECT_EQ(gen.generation_rule(false).footprint_half_xy, 0.0);
+  EXPECT_EQ(gen.flight_rule().footprint_half_xy, 0.0);
+  cfg.clearance.turned_body = false;
+  EXPECT_EQ(TrajectoryGenerator(cfg).generation_rule(true).footprint_half_xy, 0.0);
+
+  // A straight path 0.36 m beside a post, heading 45° off the way: the path itself (the
+  // fallback, exactly on it) is flown; its corner would reach 0.354 m toward the post.
+  cfg.clearance.turned_body = true;
+  cfg.optimizer.max_iterations = 0;
+  const std::vector<Eigen::Vector3d> line = {{0, 0, 1}, {4, 0, 1}};
+  const PostField post(Eigen::Vector2d(2.0, 0.36));
+  const GenerationResult r =
+      TrajectoryGenerator(cfg).generate(line, {M_PI / 4, M_PI / 4}, at_rest(line[0]), 0.0, post);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_FALSE(r.trajectory.optimized);
+  ClearanceRule turned = TrajectoryGenerator(cfg).generation_rule(true);
+  EXPECT_FALSE(check_clearance(r.trajectory, post, 0, r.trajectory.duration(), turned).ok)
+      << "the same curve, had it been optimised, would not be flown";
 }

@@ -424,6 +424,61 @@ TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {
   }
 }
 
+TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
+  // A wall across the corridor at x = 3 cuts the roadmap in two; then the map clears it (a noisy
+  // jamb, mapped again). No edge between two existing nodes is drawn by sampling: relink, run
+  // while recovering, joins the far part again through the space that is free now.
+  DepFixture f;
+  corridor(f.grid);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({1, 2, 1.2});
+  dep.plan(ctx);
+  std::vector<mapper::VoxelChange> wall, cleared;
+  const mapper::KeyMath& km = f.grid.keys();
+  for (double y = 0.05; y < 4; y += 0.1)
+    for (double z = 0.05; z < 2.5; z += 0.1) {
+      const mapper::VoxelKey k = km.key(Eigen::Vector3d(3.05, y, z));
+      f.grid.set_state(k, VoxelState::kOccupied);
+      wall.push_back({k, VoxelState::kOccupied, VoxelState::kFree});
+      cleared.push_back({k, VoxelState::kFree, VoxelState::kOccupied});
+    }
+  dep.on_map_changes(wall);
+  PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
+  dep.process_map_changes(ctx2);
+  const auto far_reachable = [&](const Roadmap::Search& s) {
+    int reached = 0, far = 0;
+    for (const RoadmapNode& n : dep.graph().slots()) {
+      if (!n.alive || n.position.x() < 3.3) continue;
+      ++far;
+      reached += s.reached(n.id) ? 1 : 0;
+    }
+    return std::make_pair(reached, far);
+  };
+  const auto [cut_reached, far] = far_reachable(dep.graph().shortest_paths(dep.root()));
+  ASSERT_GT(far, 3);
+  ASSERT_EQ(cut_reached, 0);
+
+  for (const mapper::VoxelChange& c : cleared) f.grid.set_state(c.key, VoxelState::kFree);
+  dep.on_map_changes(cleared);
+  PlanContext ctx3 = f.context({1, 2, 1.2}, 0.0, 3);
+  dep.process_map_changes(ctx3);
+  EXPECT_EQ(far_reachable(dep.graph().shortest_paths(dep.root())).first, 0) << "nothing relinks by itself";
+  EXPECT_GT(dep.relink(ctx3, dep.graph().shortest_paths(dep.root())), 0);
+  const auto [reached, far_after] = far_reachable(dep.graph().shortest_paths(dep.root()));
+  EXPECT_EQ(reached, far_after) << "every node beyond the cleared wall";
+  CollisionChecker c(f.config.collision);
+  c.set_grid(&f.grid);
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (!n.alive || n.id == dep.root()) continue;
+    for (const RoadmapEdge& e : n.edges) {
+      if (e.to == dep.root()) continue;
+      EXPECT_TRUE(c.edge_free(n.position, dep.graph().node(e.to).position));
+    }
+  }
+}
+
 TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   DepFixture f;
   corridor(f.grid);

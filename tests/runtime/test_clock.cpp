@@ -169,3 +169,26 @@ TEST(ClockServer, APromiseCountsAtMostTheSlackAhead) {
   EXPECT_TRUE(s.on_ack("evaluator", 1, std::numeric_limits<int64_t>::max()));
   EXPECT_TRUE(s.poll(0.0));
 }
+
+TEST(ClockServer, CountsWhomItWaitedOnAndHowLong) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"mapper", "planner"};
+  ClockServer s(cfg);
+  ASSERT_TRUE(s.poll(10.0));
+  s.mark_published(10.5);  // the simulator stepped for 0.5 s before the tick went out
+  EXPECT_FALSE(s.on_ack("mapper", 0, 0, 10.6));
+  EXPECT_TRUE(s.on_ack("planner", 0, 0, 11.0));  // the last ack: 0.5 s after the tick went out
+  ASSERT_TRUE(s.poll(11.0));
+  s.mark_published(11.0);
+  EXPECT_FALSE(s.on_ack("planner", 1, 0, 11.1));
+  EXPECT_TRUE(s.on_ack("mapper", 1, 0, 11.25));
+  ASSERT_EQ(s.waited_on().size(), 2u);
+  EXPECT_NEAR(s.waited_on().at("planner"), 0.5, 1e-12);
+  EXPECT_NEAR(s.waited_on().at("mapper"), 0.25, 1e-12);
+  // Without a wall time nothing is counted.
+  ASSERT_TRUE(s.poll(12.0));
+  s.on_ack("planner", 2);
+  s.on_ack("mapper", 2);
+  EXPECT_NEAR(s.waited_on().at("mapper"), 0.25, 1e-12);
+}

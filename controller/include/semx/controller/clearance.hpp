@@ -21,7 +21,17 @@ struct ClearanceRule {
   bool allow_escape = true;    // a start below `bound` may climb out without getting closer
   double escape_slack = 0.01;  // m, how much closer than its start an escape may wobble
   bool require_exit = true;    // an escape must reach the bound before t1 (off for a horizon)
+  // The body box, turned by the trajectory's yaw: outside an escape, a sample also needs the box's
+  // reach toward its nearest obstacle (the support along the ESDF gradient) plus footprint_margin.
+  // 0 = off. `bound` assumes a face toward the obstacle; a corner reaches up to √2 farther.
+  double footprint_half_xy = 0.0;  // m, half width and length
+  double footprint_half_z = 0.0;   // m, half height
+  double footprint_margin = 0.0;   // m
 };
+
+// How far a box of half sizes (half_xy, half_xy, half_z), turned by `yaw`, reaches along the
+// unit direction n (world frame).
+double footprint_reach(const Eigen::Vector3d& n, double yaw, double half_xy, double half_z);
 
 struct ClearanceReport {
   bool ok = true;
@@ -31,6 +41,7 @@ struct ClearanceReport {
   double violation_time = -1.0;  // first sample breaking the rule, s; < 0 when none
   Eigen::Vector3d violation_point = Eigen::Vector3d::Zero();
   double violation_distance = 0.0;
+  bool footprint = false;        // the violation is the turned body's reach, not `bound`
   int samples = 0;
 };
 

@@ -31,6 +31,18 @@ struct ClearanceConfig {
   double margin = 0.07;
   double brake_margin = 0.05;   // m, a flown trajectory brakes when it would come below half_size
                                 // + brake_margin (smaller than margin: no brake on map jitter)
+  // The body box turned by the trajectory's yaw (turned_body): an optimised trajectory also keeps
+  // the box's reach toward the nearest obstacle (along the ESDF gradient) + footprint_margin. The
+  // bounds above assume a face toward the obstacle: beside a wall's end the box's corner reaches
+  // √2 × 0.25 = 0.354 m. An optimised trajectory that cut a path's corner passed a wall's end at
+  // 0.34 m (ESDF 0.328 > 0.32) heading -89°, diagonally from it, and the box's corner hit it
+  // (env3, 30 samples, seed 3, at 260 s). Not for the fallback, which is the planner's path (in a
+  // doorway its centre line is 0.35 m from the jambs in the ESDF, 0.45 m in the world: with the
+  // rule, a vehicle heading diagonally there had every path rejected for 800 s, env3 seed 2), nor
+  // for braking. Where the gradient vanishes (a ridge) the direction is unknown: the bounds apply.
+  double half_height = 0.15;       // m, the body box's (0.3 m high)
+  double footprint_margin = 0.02;  // m
+  bool turned_body = true;
   double check_spacing = 0.02;  // m, arc length between dense clearance samples
   // A trajectory that starts below the bound (the vehicle already is) may climb out of it
   // without getting closer than its start; otherwise such a vehicle could never move again.

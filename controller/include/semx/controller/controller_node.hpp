@@ -21,7 +21,9 @@ class ControllerNode {
   runtime::Node& node() { return node_; }
   const runtime::Node& node() const { return node_; }
   Controller& controller() { return controller_; }
-  int run() { return node_.run(); }
+  // Runs until shutdown, then prints the counters (how many trajectories took the fallback and
+  // why) to stdout: RUN/logs/controller.log.
+  int run();
 
   // One tick of simulation time (what SIM_CLOCK triggers); public for tests.
   void on_tick(int64_t tick, int64_t utime);

@@ -3,7 +3,7 @@
 //
 //   1. time allocation along the polyline (time_allocation.hpp), control points sampled from it
 //      at the knot interval, the first three fixing the vehicle's position and velocity;
-//   2. ESDF optimisation (trajectory_optimizer.hpp);
+//   2. ESDF optimisation (trajectory_optimizer.hpp), kept only within max_deviation of the path;
 //   3. uniform time scaling so speed and acceleration are within the limits everywhere;
 //   4. the yaw profile (yaw_profile.hpp);
 //   5. the dense clearance check (clearance.hpp).
@@ -30,8 +30,12 @@ struct StartState {
   double yaw = 0.0;
 };
 
+// Why an optimised trajectory was not flown (the fallback was tried instead).
+enum class FallbackCause { kNone, kOptimizerOff, kOptimizerFailed, kStrays, kTooClose };
+
 struct GenerationResult {
   bool ok = false;        // `trajectory` is safe to fly
+  FallbackCause cause = FallbackCause::kNone;
   Trajectory trajectory;  // plan_id, start_utime left to the caller
   std::string reason;     // why the fallback was used, or why there is no trajectory
   OptimizerReport optimizer;
@@ -49,14 +53,19 @@ class TrajectoryGenerator {
   GenerationResult generate(const std::vector<Eigen::Vector3d>& polyline, const std::vector<double>& yaws,
                             const StartState& start, double max_speed, const DistanceField& field) const;
 
-  // The rule a new trajectory must meet (bound = half_size + margin).
-  ClearanceRule generation_rule() const;
+  // The rule a new trajectory must meet (bound = half_size + margin); an optimised one also the
+  // turned body's reach (clearance.turned_body). The fallback follows the planner's path exactly,
+  // whose clearance is the planner's to keep: in a doorway its centre line is 0.35 m from the
+  // jambs in the ESDF (0.45 m in the world), below the reach of a body heading diagonally.
+  ClearanceRule generation_rule(bool optimised = true) const;
   // The rule a flown trajectory is held to on each new ESDF (bound = half_size + brake_margin).
   ClearanceRule flight_rule() const;
 
   // The farthest the curve gets from the polyline (sampled every kDeviationStep of its time).
   static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline);
   static constexpr double kDeviationStep = 0.05;  // s
+  // The point of the polyline nearest to p.
+  static Eigen::Vector3d nearest_on_path(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& polyline);
 
   // Speed limit for a path asking for `max_speed` (0 = none).
   double speed_limit(double max_speed) const;

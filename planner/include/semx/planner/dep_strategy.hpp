@@ -75,6 +75,9 @@ class DepStrategy : public Strategy {
   // Candidates between parts of the roadmap the root cannot reach and the nearest reachable
   // nodes (sampling.bridge_attempts per cycle).
   void bridge(PlanContext& ctx);
+  // Recovering: edges again between each unreachable node and the nearest reachable node within
+  // an edge's length, where they pass the edge check now. Returns the edges added.
+  int relink(PlanContext& ctx, const Roadmap::Search& reach);
   // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
   using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
   // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach.

@@ -46,9 +46,16 @@ class ClockServer {
 
   // What to publish at wall time `wall_s` (monotonic seconds), if anything.
   std::optional<ClockTick> poll(double wall_s);
-  // Records an ack (with its promise, 0 for none); returns true if it completed the current
-  // tick's set.
-  bool on_ack(const std::string& node, int64_t tick, int64_t quiet_until = 0);
+  // Records an ack (with its promise, 0 for none) received at wall time `wall_s` (< 0: unknown);
+  // returns true if it completed the current tick's set.
+  bool on_ack(const std::string& node, int64_t tick, int64_t quiet_until = 0, double wall_s = -1.0);
+  // The current tick actually went out at `wall_s` (after the simulator stepped and published its
+  // sensors): waits are counted from here.
+  void mark_published(double wall_s) { tick_sent_at_ = wall_s; }
+  // LOCKSTEP: per node, the wall seconds from a tick's first sending to the ack that completed
+  // its set, when that ack was the node's: whom the clock waited on, and how long (what to make
+  // faster for a faster lockstep run).
+  const std::map<std::string, double>& waited_on() const { return waited_on_; }
 
   bool finished() const;  // max_ticks reached (and acked, in LOCKSTEP)
   int64_t current_tick() const { return tick_; }
@@ -72,6 +79,7 @@ class ClockServer {
   bool satisfied(const std::string& node) const;
 
   std::map<std::string, NodeAcks> acks_;
+  std::map<std::string, double> waited_on_;
 };
 
 }  // namespace semx::runtime
