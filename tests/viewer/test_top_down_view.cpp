@@ -125,6 +125,49 @@ TEST(TopDownView, DrawsEachLayerInItsColourAtItsPlace) {
   EXPECT_NE(h.find("semantic-dep EXECUTING #7"), std::string::npos) << h;
 }
 
+TEST(TopDownView, DrawsTheControllersTrajectoryAlongItsCurve) {
+  // Collinear, evenly spaced control points: a cubic B-spline on the line, from the average
+  // (q0 + 4 q1 + q2) / 6 of the first three to that of the last three.
+  TrajectoryCurve line;
+  line.knot_interval = 0.25;
+  for (int i = 0; i < 8; ++i) line.control_points.emplace_back(0.5 + 0.5 * i, 2.5, 1.0);
+  const std::vector<Eigen::Vector3d> pts = sample_curve(line, 0.05);
+  ASSERT_EQ(pts.size(), 5u * 5 + 1);
+  EXPECT_NEAR(pts.front().x(), 1.0, 1e-12);
+  EXPECT_NEAR(pts.back().x(), 3.5, 1e-12);
+  for (size_t i = 1; i < pts.size(); ++i) {
+    EXPECT_NEAR(pts[i].y(), 2.5, 1e-12);
+    EXPECT_NEAR(pts[i].x() - pts[i - 1].x(), 0.1, 1e-9) << "uniform speed on a uniform line";
+  }
+  line.control_points.resize(3);
+  EXPECT_TRUE(sample_curve(line).empty()) << "too few control points for a cubic";
+
+  const mapper::StateGrid grid = hand_map();
+  TopDownView view(fixed_options());
+  TrajectoryCurve c;
+  c.knot_interval = 0.25;
+  for (int i = 0; i < 8; ++i) c.control_points.emplace_back(0.5 + 0.5 * i, 2.5, 1.0);
+  ASSERT_TRUE(view.set_trajectory(c));
+  evaluator::MapPicture pic = view.picture(&grid);
+  Image img = pic.render();
+  EXPECT_TRUE(near_pixel(img, pic.pixel({2.5, 2.5}), TopDownViewOptions{}.trajectory, 10));
+  // The fallback in its own colour; NaN control points are dropped, not drawn.
+  c.optimized = false;
+  c.control_points.insert(c.control_points.begin() + 2, Eigen::Vector3d(kNaN, 0, 0));
+  ASSERT_TRUE(view.set_trajectory(c));
+  EXPECT_EQ(view.trajectory().size(), pts.size());
+  pic = view.picture(&grid);
+  img = pic.render();
+  EXPECT_TRUE(near_pixel(img, pic.pixel({2.5, 2.5}), TopDownViewOptions{}.fallback_trajectory, 10));
+  EXPECT_FALSE(near_pixel(img, pic.pixel({2.5, 2.5}), TopDownViewOptions{}.trajectory, 10));
+  // A knot interval off the wire that is no time: its control polygon.
+  c.knot_interval = kNaN;
+  ASSERT_TRUE(view.set_trajectory(c));
+  EXPECT_EQ(view.trajectory().size(), 8u);
+  view.clear_run();
+  EXPECT_TRUE(view.trajectory().empty());
+}
+
 TEST(TopDownView, NodesAreColouredByTheRankOfTheirScore) {
   TopDownView view;
   Roadmap r;

@@ -10,6 +10,7 @@
 #include <semx/planner_status_t.hpp>
 #include <semx/roadmap_t.hpp>
 #include <semx/semantic_regions_t.hpp>
+#include <semx/trajectory_t.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -294,8 +295,8 @@ TEST(ViewerNode, InLockstepDrawsOnTicksAndAcksThem) {
 TEST(ViewerNode, SurvivesHostileMessagesAndKeepsDrawing) {
   std::vector<Event> bad;
   const std::vector<uint8_t> junk = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17};
-  for (const char* c : {ch::ROADMAP, ch::SEMANTIC_REGIONS, ch::PLAN_PATH, ch::ODOMETRY, ch::PLANNER_STATUS,
-                        ch::MAP_UPDATE, ch::MAP_SNAPSHOT, ch::SIM_CLOCK}) {
+  for (const char* c : {ch::ROADMAP, ch::SEMANTIC_REGIONS, ch::PLAN_PATH, ch::TRAJECTORY, ch::ODOMETRY,
+                        ch::PLANNER_STATUS, ch::MAP_UPDATE, ch::MAP_SNAPSHOT, ch::SIM_CLOCK}) {
     bad.push_back({c, junk});
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -319,6 +320,14 @@ TEST(ViewerNode, SurvivesHostileMessagesAndKeepsDrawing) {
   semx::path_t p = path(900000);
   p.waypoints[1][0] = nan;
   bad.push_back(event(ch::PLAN_PATH, p));
+  semx::trajectory_t tr{};
+  tr.utime = 900000;
+  tr.degree = 3;
+  tr.knot_interval = -1e300;
+  tr.num_control_points = 5;
+  tr.control_points.assign(5, {nan, 1e300, 0});
+  tr.yaw_control_points.assign(5, nan);
+  bad.push_back(event(ch::TRAJECTORY, tr));
   semx::planner_status_t s = status(900000, 99);
   s.planner = std::string(10000, 'p');
   bad.push_back(event(ch::PLANNER_STATUS, s));
@@ -330,7 +339,7 @@ TEST(ViewerNode, SurvivesHostileMessagesAndKeepsDrawing) {
   events.insert(events.end(), normal.begin() + 16, normal.end());
   const Live live = run_live("hostile", events, false);
   EXPECT_EQ(live.counters.handler_errors, 0);
-  EXPECT_GE(live.counters.malformed, 8);
+  EXPECT_GE(live.counters.malformed, 9);
   // The far-future stamp did not stop the frames; all of them were still written.
   for (int k = 0; k <= 6; ++k) EXPECT_TRUE(fs::is_regular_file(live.dir + "/" + frame_file_name(k))) << k;
   EXPECT_LE(live.frames.at(6).time, 3000000);

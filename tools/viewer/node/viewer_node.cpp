@@ -7,6 +7,7 @@
 #include <semx/planner_status_t.hpp>
 #include <semx/roadmap_t.hpp>
 #include <semx/semantic_regions_t.hpp>
+#include <semx/trajectory_t.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -115,6 +116,16 @@ ViewerNode::ViewerNode(runtime::Node& node, ViewerNodeOptions options)
     w.reserve(m.waypoints.size());
     for (const auto& p : m.waypoints) w.emplace_back(p[0], p[1], p[2]);
     view_.set_path(std::move(w));
+  });
+  node_.subscribe<semx::trajectory_t>(ch::TRAJECTORY, [this](const semx::trajectory_t& m) {
+    message_time(m.utime);
+    TrajectoryCurve c;
+    c.degree = m.degree;
+    c.knot_interval = m.knot_interval;
+    c.optimized = m.optimized;
+    c.control_points.reserve(m.control_points.size());
+    for (const auto& p : m.control_points) c.control_points.emplace_back(p[0], p[1], p[2]);
+    view_.set_trajectory(c);
   });
   node_.subscribe<semx::planner_status_t>(ch::PLANNER_STATUS, [this](const semx::planner_status_t& m) {
     message_time(m.utime);

@@ -1,5 +1,5 @@
 // semx-viewer's LCM side: a TopDownView fed from the bus. A MapClient keeps the map (deltas,
-// snapshots on gaps); ODOMETRY, ROADMAP, SEMANTIC_REGIONS, PLAN_PATH and PLANNER_STATUS update
+// snapshots on gaps); ODOMETRY, ROADMAP, SEMANTIC_REGIONS, PLAN_PATH, TRAJECTORY and PLANNER_STATUS update
 // the overlays; a frame is drawn once per `period_s` of message time and written as
 // out_dir/frame_NNNNNN.png (N = the frame's index, message time / period) and/or handed to
 // `on_frame` (the window).

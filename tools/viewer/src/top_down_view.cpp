@@ -139,6 +139,43 @@ bool TopDownView::set_path(std::vector<Eigen::Vector3d> waypoints) {
   return usable;
 }
 
+std::vector<Eigen::Vector3d> sample_curve(const TrajectoryCurve& c, double step_s) {
+  const auto& q = c.control_points;
+  std::vector<Eigen::Vector3d> out;
+  if (c.degree != 3) return q;  // not a cubic: its control polygon, which the curve stays near
+  if (q.size() < 4 || !(c.knot_interval > 0) || !(step_s > 0)) return out;
+  // Segment i spans [i·dt, (i+1)·dt) on control points i..i+3 (uniform cubic B-spline basis).
+  const size_t segments = q.size() - 3;
+  const int per_segment = std::max(1, static_cast<int>(std::ceil(c.knot_interval / step_s)));
+  for (size_t i = 0; i < segments; ++i) {
+    for (int k = 0; k < per_segment || (i + 1 == segments && k == per_segment); ++k) {
+      const double u = static_cast<double>(k) / per_segment, u2 = u * u, u3 = u2 * u;
+      const double b0 = (1 - 3 * u + 3 * u2 - u3) / 6, b1 = (4 - 6 * u2 + 3 * u3) / 6,
+                   b2 = (1 + 3 * u + 3 * u2 - 3 * u3) / 6, b3 = u3 / 6;
+      out.push_back(b0 * q[i] + b1 * q[i + 1] + b2 * q[i + 2] + b3 * q[i + 3]);
+    }
+  }
+  return out;
+}
+
+bool TopDownView::set_trajectory(const TrajectoryCurve& curve) {
+  // Control points off the wire: the same sanity as a path, before any arithmetic on them.
+  TrajectoryCurve c = curve;
+  c.control_points.clear();
+  for (const auto& p : curve.control_points) {
+    if (c.control_points.size() >= options_.limits.max_path_points || !plausible(p)) {
+      ++skipped_;
+      continue;
+    }
+    c.control_points.push_back(p);
+  }
+  if (!std::isfinite(c.knot_interval) || c.knot_interval <= 0 || c.knot_interval > 10) c.degree = 0;
+  trajectory_ = sample_curve(c);
+  if (trajectory_.size() > options_.limits.max_path_points) trajectory_.resize(options_.limits.max_path_points);
+  trajectory_optimized_ = curve.optimized;
+  return !trajectory_.empty() || curve.control_points.empty();
+}
+
 void TopDownView::set_planner(PlannerInfo info) {
   info.planner = clean_label(info.planner);
   // Reasons are sentences: allow a longer text than labels.
@@ -158,6 +195,7 @@ void TopDownView::clear_run() {
   roadmap_ = Roadmap{};
   regions_.clear();
   path_.clear();
+  trajectory_.clear();
   planner_ = PlannerInfo{};
 }
 
@@ -345,6 +383,7 @@ evaluator::MapPicture TopDownView::picture(const mapper::StateGrid* grid) {
 
   pic.add_polyline(trail_, options_.trail, 2);
   pic.add_polyline(path_, options_.path, 2);
+  pic.add_polyline(trajectory_, trajectory_optimized_ ? options_.trajectory : options_.fallback_trajectory, 2);
 
   // Nodes over the lines; the goal last so it stays visible.
   const RoadmapNode* goal = nullptr;
@@ -367,6 +406,10 @@ evaluator::MapPicture TopDownView::picture(const mapper::StateGrid* grid) {
 
   pic.add_legend("trail", options_.trail);
   pic.add_legend("path", options_.path);
+  if (!trajectory_.empty()) {
+    pic.add_legend(trajectory_optimized_ ? "trajectory (optimised)" : "trajectory (fallback)",
+                   trajectory_optimized_ ? options_.trajectory : options_.fallback_trajectory);
+  }
   pic.add_legend("vehicle", options_.vehicle);
   if (!roadmap_.nodes.empty()) {
     pic.add_legend("node: low score", score_color(0));

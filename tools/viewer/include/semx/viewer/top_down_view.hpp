@@ -51,6 +51,17 @@ struct Region {
   bool active = true;
 };
 
+// The controller's trajectory (TRAJECTORY): a uniform B-spline of position control points.
+struct TrajectoryCurve {
+  int degree = 3;
+  double knot_interval = 0.25;  // s
+  std::vector<Eigen::Vector3d> control_points;
+  bool optimized = true;  // false: the fallback, on the planner's path at lower speed
+};
+// Points of the curve every `step_s` of its time (degree 3; any other degree: its control
+// polygon). Empty when there are fewer control points than degree + 1.
+std::vector<Eigen::Vector3d> sample_curve(const TrajectoryCurve& c, double step_s = 0.05);
+
 struct PlannerInfo {
   std::string planner;
   int state = -1;  // planner_status_t's INIT..FAILED; -1: nothing heard
@@ -93,6 +104,8 @@ struct TopDownViewOptions {
 
   evaluator::Rgb trail{30, 90, 220};
   evaluator::Rgb path{200, 30, 200};
+  evaluator::Rgb trajectory{240, 140, 0};           // optimised
+  evaluator::Rgb fallback_trajectory{150, 90, 40};  // the fallback
   evaluator::Rgb vehicle{0, 150, 160};
   evaluator::Rgb goal{0, 150, 60};
   evaluator::Rgb walls{176, 176, 192};  // ground-truth walls the map does not know (faint)
@@ -113,6 +126,7 @@ class TopDownView {
   bool set_roadmap(Roadmap roadmap);
   bool set_regions(std::vector<Region> regions);
   bool set_path(std::vector<Eigen::Vector3d> waypoints);
+  bool set_trajectory(const TrajectoryCurve& curve);
   void set_planner(PlannerInfo info);
   // The simulation time the header shows (the node's message time).
   void set_time(int64_t utime) { utime_ = utime; }
@@ -124,6 +138,7 @@ class TopDownView {
   const Roadmap& roadmap() const { return roadmap_; }
   const std::vector<Region>& regions() const { return regions_; }
   const std::vector<Eigen::Vector3d>& path() const { return path_; }
+  const std::vector<Eigen::Vector3d>& trajectory() const { return trajectory_; }
   const PlannerInfo& planner() const { return planner_; }
   std::optional<Eigen::Vector3d> position() const { return pose_position_; }
   double yaw() const { return yaw_; }
@@ -168,6 +183,8 @@ class TopDownView {
   Roadmap roadmap_;
   std::vector<Region> regions_;
   std::vector<Eigen::Vector3d> path_;
+  std::vector<Eigen::Vector3d> trajectory_;
+  bool trajectory_optimized_ = true;
   PlannerInfo planner_;
   int64_t utime_ = 0;
   int64_t skipped_ = 0;
