@@ -13,7 +13,8 @@ namespace semx::controller {
 
 double footprint_reach(const Eigen::Vector3d& n, double yaw, double half_xy, double half_z) {
   const double c = std::cos(yaw), s = std::sin(yaw);
-  return half_xy * (std::abs(c * n.x() + s * n.y()) + std::abs(-s * n.x() + c * n.y())) + half_z * std::abs(n.z());
+  return half_xy * (std::abs(c * n.x() + s * n.y()) + std::abs(-s * n.x() + c * n.y())) +
+         half_z * std::abs(n.z());
 }
 
 ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceField& field, double t0,

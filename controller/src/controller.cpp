@@ -124,9 +124,14 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   ++(trajectory_->optimized ? counters_.optimized : counters_.fallbacks);
   if (!trajectory_->optimized) {
     switch (last_generation_.cause) {
-      case FallbackCause::kStrays: ++counters_.fallback_strays; break;
-      case FallbackCause::kTooClose: ++counters_.fallback_too_close; break;
-      default: break;
+      case FallbackCause::kStrays:
+        ++counters_.fallback_strays;
+        break;
+      case FallbackCause::kTooClose:
+        ++counters_.fallback_too_close;
+        break;
+      default:
+        break;
     }
   }
   error_sq_sum_ = 0;

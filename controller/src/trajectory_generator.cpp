@@ -15,8 +15,9 @@ namespace {
 std::string describe(const ClearanceReport& c) {
   std::ostringstream s;
   s.precision(3);
-  s << (c.footprint ? "the turned body's reach, " : "") << "distance " << c.violation_distance << " m at t = " << c.violation_time << " s ("
-    << c.violation_point.x() << ", " << c.violation_point.y() << ", " << c.violation_point.z() << ")";
+  s << (c.footprint ? "the turned body's reach, " : "") << "distance " << c.violation_distance
+    << " m at t = " << c.violation_time << " s (" << c.violation_point.x() << ", " << c.violation_point.y()
+    << ", " << c.violation_point.z() << ")";
   return s.str();
 }
 
@@ -104,7 +105,8 @@ Eigen::Vector3d TrajectoryGenerator::nearest_on_path(const Eigen::Vector3d& p,
   return best;
 }
 
-double TrajectoryGenerator::deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline) {
+double TrajectoryGenerator::deviation(const PositionSpline& curve,
+                                      const std::vector<Eigen::Vector3d>& polyline) {
   if (polyline.empty()) return 0.0;
   const double duration = curve.duration();
   const int n = std::max(1, static_cast<int>(std::ceil(duration / kDeviationStep)));
@@ -135,7 +137,8 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
     if (result.optimizer.failed) {
       why = "optimiser failed (" + result.optimizer.message + ")";
       result.cause = FallbackCause::kOptimizerFailed;
-    } else if (const double off = deviation(smooth.position, polyline); off > config_.trajectory.max_deviation) {
+    } else if (const double off = deviation(smooth.position, polyline);
+               off > config_.trajectory.max_deviation) {
       std::ostringstream s;
       s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
       why = s.str();

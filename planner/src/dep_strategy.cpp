@@ -281,7 +281,8 @@ int DepStrategy::relink(PlanContext& ctx, const Roadmap::Search& reach) {
       if (static_cast<size_t>(a) >= reach.distance.size() || !reach.reached(a)) continue;
       const Eigen::Vector3d& p = graph_.node(a).position;
       ++ctx.counters->edges_checked;
-      const bool free = a == root_ ? checker_.root_edge_free(p, n.position) : checker_.edge_free(p, n.position);
+      const bool free =
+          a == root_ ? checker_.root_edge_free(p, n.position) : checker_.edge_free(p, n.position);
       if (free) {
         graph_.add_edge(a, n.id, (p - n.position).norm());
         ++ctx.counters->edges_added;

@@ -148,7 +148,8 @@ int main(int argc, char** argv) {
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
         .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors)
-        .repeated("edge", "AX,AY,AZ,BX,BY,BZ", "one edge: what each check says about it and its ends", &edges);
+        .repeated("edge", "AX,AY,AZ,BX,BY,BZ", "one edge: what each check says about it and its ends",
+                  &edges);
     if (!p.parse(argc, argv)) return 0;
     const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
     mapper::OccupancyMap map{mapper::OccupancyParams()};
@@ -176,18 +177,21 @@ int main(int argc, char** argv) {
       }
       const auto state = [&](const Eigen::Vector3d& q) {
         const mapper::VoxelState v = map.grid().state(q);
-        return v == mapper::VoxelState::kFree ? "free" : v == mapper::VoxelState::kOccupied ? "occupied" : "unknown";
+        return v == mapper::VoxelState::kFree       ? "free"
+               : v == mapper::VoxelState::kOccupied ? "occupied"
+                                                    : "unknown";
       };
       for (const Eigen::Vector3d& q : {a, b})
         std::printf("point (%.2f %.2f %.2f): %s, node_free %d, passage_free %d, vehicle_free %d, esdf %.3f\n",
                     q.x(), q.y(), q.z(), state(q), checker.node_free(q), checker.passage_free(q),
                     checker.vehicle_free(q), checker.esdf(q, 1.0));
-      std::printf("edge: edge_free %d, root_edge_free %d\n", checker.edge_free(a, b), checker.root_edge_free(a, b));
+      std::printf("edge: edge_free %d, root_edge_free %d\n", checker.edge_free(a, b),
+                  checker.root_edge_free(a, b));
     }
     if (!edges.empty() && list.empty()) return 0;
     if (list.empty()) {
-      list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'},  {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
-              {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'},  {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};
+      list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'}, {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
+              {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'}, {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};
     }
     for (const Door& d : list) probe(map.grid(), checker, d);
     return 0;

@@ -42,8 +42,8 @@ void SimulatorNode::on_command(const semx::control_cmd_t& m) {
   }
 }
 
-void SimulatorNode::publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid,
-                                  int64_t count) {
+void SimulatorNode::publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where,
+                                  int solid, int64_t count) {
   semx::sim_event_t e{};
   e.utime = sim_.time_us();
   e.type = type;
@@ -56,9 +56,12 @@ void SimulatorNode::publish_event(int8_t type, const std::string& text, const Ei
 
 void SimulatorNode::publish_frame() {
   sim_.render_camera(frame_, options_.render_channels);
-  if (frame_.channels & kRenderDepth) node_.publish(ch::CAMERA_DEPTH, depth_message(frame_, options_.depth_codec));
-  if (frame_.channels & (kRenderRgb | kRenderRgbRuns)) node_.publish(ch::CAMERA_RGB, rgb_message(frame_, options_.rgb_codec));
-  if (frame_.channels & kRenderLabels) node_.publish(ch::CAMERA_LABELS, label_message(frame_, options_.label_codec));
+  if (frame_.channels & kRenderDepth)
+    node_.publish(ch::CAMERA_DEPTH, depth_message(frame_, options_.depth_codec));
+  if (frame_.channels & (kRenderRgb | kRenderRgbRuns))
+    node_.publish(ch::CAMERA_RGB, rgb_message(frame_, options_.rgb_codec));
+  if (frame_.channels & kRenderLabels)
+    node_.publish(ch::CAMERA_LABELS, label_message(frame_, options_.label_codec));
   ++frames_;
 }
 
@@ -75,8 +78,8 @@ void SimulatorNode::advance_to(int64_t utime) {
     if (r.imu) node_.publish(ch::IMU, to_message(*r.imu));
     if (r.odometry) node_.publish(ch::ODOMETRY, to_message(*r.odometry));
     if (r.collision) {
-      publish_event(semx::sim_event_t::COLLISION, "body box hit a solid", r.collision->position, r.collision->solid,
-                    r.collision->count);
+      publish_event(semx::sim_event_t::COLLISION, "body box hit a solid", r.collision->position,
+                    r.collision->solid, r.collision->count);
     }
     if (r.camera_due) publish_frame();
   }
@@ -104,10 +107,10 @@ bool SimulatorNode::poll(double wall_s) {
     const double sim_s = static_cast<double>(t->utime) * 1e-6;
     if (options_.progress_every_s > 0 && sim_s >= next_progress_s_) {
       const auto o = sim_.odometry();
-      std::printf("semx-simulator: t=%.1f s  pos=(%.2f, %.2f, %.2f)  frames=%lld  collisions=%lld  %.1fx real time\n",
-                  sim_s, o.position.x(), o.position.y(), o.position.z(), static_cast<long long>(frames_),
-                  static_cast<long long>(sim_.vehicle().collisions()),
-                  sim_s / std::max(1e-9, wall_s - wall_start_));
+      std::printf(
+          "semx-simulator: t=%.1f s  pos=(%.2f, %.2f, %.2f)  frames=%lld  collisions=%lld  %.1fx real time\n",
+          sim_s, o.position.x(), o.position.y(), o.position.z(), static_cast<long long>(frames_),
+          static_cast<long long>(sim_.vehicle().collisions()), sim_s / std::max(1e-9, wall_s - wall_start_));
       next_progress_s_ += options_.progress_every_s;
     }
   }
@@ -132,10 +135,11 @@ int SimulatorNode::run() {
     publish_event(semx::sim_event_t::EPISODE_END, "time limit", sim_.odometry().position, -1, 1);
     node_.set_state(runtime::NodeState::kDone, "episode ended");
   }
-  std::printf("semx-simulator: simulated %.2f s in %.2f s wall (%.1fx real time), %lld frames, %lld collisions, "
-              "%lld commands rejected\n",
-              sim_s, wall, sim_s / std::max(1e-9, wall), static_cast<long long>(frames_),
-              static_cast<long long>(sim_.vehicle().collisions()), static_cast<long long>(rejected_));
+  std::printf(
+      "semx-simulator: simulated %.2f s in %.2f s wall (%.1fx real time), %lld frames, %lld collisions, "
+      "%lld commands rejected\n",
+      sim_s, wall, sim_s / std::max(1e-9, wall), static_cast<long long>(frames_),
+      static_cast<long long>(sim_.vehicle().collisions()), static_cast<long long>(rejected_));
   if (lockstep && !server_.waited_on().empty()) {
     // Whom the clock waited on: the node whose ack completed each tick, and for how long.
     std::vector<std::pair<double, std::string>> w;
@@ -145,7 +149,8 @@ int SimulatorNode::run() {
       total += s;
     }
     std::sort(w.rbegin(), w.rend());
-    std::printf("semx-simulator: lockstep: %.2f s of the %.2f s wall waiting for acks; completed by", total, wall);
+    std::printf("semx-simulator: lockstep: %.2f s of the %.2f s wall waiting for acks; completed by", total,
+                wall);
     for (const auto& [s, name] : w) std::printf(" %s %.2f s,", name.c_str(), s);
     std::printf(" the rest in the simulator\n");
   }

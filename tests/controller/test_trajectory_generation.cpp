@@ -13,8 +13,8 @@
 
 using namespace semx::controller;
 using semx::controller::test::FreeField;
-using semx::controller::test::TubeField;
 using semx::controller::test::PostField;
+using semx::controller::test::TubeField;
 
 namespace {
 
@@ -327,8 +327,8 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback
   // A corner at 1 m/s: the optimiser rounds it, well within max_deviation...
   const std::vector<Eigen::Vector3d> corner = {{0, 0, 1}, {3, 0, 1}, {3, 3, 1}};
   ControllerConfig cfg;
-  const GenerationResult smooth = TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]),
-                                                                    0.0, FreeField());
+  const GenerationResult smooth =
+      TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]), 0.0, FreeField());
   ASSERT_TRUE(smooth.ok) << smooth.reason;
   EXPECT_TRUE(smooth.trajectory.optimized) << smooth.reason;
   const double cut = TrajectoryGenerator::deviation(smooth.trajectory.position, corner);
@@ -336,8 +336,8 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback
   EXPECT_LE(cut, cfg.trajectory.max_deviation);
   // ... but not within a corridor narrower than its cut: then the fallback, on the path itself.
   cfg.trajectory.max_deviation = 0.5 * cut;
-  const GenerationResult strict = TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]),
-                                                                    0.0, FreeField());
+  const GenerationResult strict =
+      TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]), 0.0, FreeField());
   ASSERT_TRUE(strict.ok) << strict.reason;
   EXPECT_FALSE(strict.trajectory.optimized);
   EXPECT_NE(strict.reason.find("strays"), std::string::npos) << strict.reason;

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <optional>
+#include <random>
 #include <set>
 
 #include "planner_test_util.hpp"

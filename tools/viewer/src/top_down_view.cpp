@@ -171,7 +171,8 @@ bool TopDownView::set_trajectory(const TrajectoryCurve& curve) {
   }
   if (!std::isfinite(c.knot_interval) || c.knot_interval <= 0 || c.knot_interval > 10) c.degree = 0;
   trajectory_ = sample_curve(c);
-  if (trajectory_.size() > options_.limits.max_path_points) trajectory_.resize(options_.limits.max_path_points);
+  if (trajectory_.size() > options_.limits.max_path_points)
+    trajectory_.resize(options_.limits.max_path_points);
   trajectory_optimized_ = curve.optimized;
   return !trajectory_.empty() || curve.control_points.empty();
 }
@@ -383,7 +384,8 @@ evaluator::MapPicture TopDownView::picture(const mapper::StateGrid* grid) {
 
   pic.add_polyline(trail_, options_.trail, 2);
   pic.add_polyline(path_, options_.path, 2);
-  pic.add_polyline(trajectory_, trajectory_optimized_ ? options_.trajectory : options_.fallback_trajectory, 2);
+  pic.add_polyline(trajectory_, trajectory_optimized_ ? options_.trajectory : options_.fallback_trajectory,
+                   2);
 
   // Nodes over the lines; the goal last so it stays visible.
   const RoadmapNode* goal = nullptr;

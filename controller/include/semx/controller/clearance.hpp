@@ -41,7 +41,7 @@ struct ClearanceReport {
   double violation_time = -1.0;  // first sample breaking the rule, s; < 0 when none
   Eigen::Vector3d violation_point = Eigen::Vector3d::Zero();
   double violation_distance = 0.0;
-  bool footprint = false;        // the violation is the turned body's reach, not `bound`
+  bool footprint = false;  // the violation is the turned body's reach, not `bound`
   int samples = 0;
 };
 

@@ -29,8 +29,8 @@ struct ClearanceConfig {
   // 0.42 m everywhere but in such doorways (docs/planner.md), and the optimiser aims at
   // bound + target_margin, so those, not this bound, set the usual distance.
   double margin = 0.07;
-  double brake_margin = 0.05;   // m, a flown trajectory brakes when it would come below half_size
-                                // + brake_margin (smaller than margin: no brake on map jitter)
+  double brake_margin = 0.05;  // m, a flown trajectory brakes when it would come below half_size
+                               // + brake_margin (smaller than margin: no brake on map jitter)
   // The body box turned by the trajectory's yaw (turned_body): an optimised trajectory also keeps
   // the box's reach toward the nearest obstacle (along the ESDF gradient) + footprint_margin. The
   // bounds above assume a face toward the obstacle: beside a wall's end the box's corner reaches

@@ -27,17 +27,17 @@ struct ControllerStatus {
 };
 
 struct ControllerCounters {
-  int64_t paths = 0;         // PLAN_PATHs received
-  int64_t superseded = 0;    // replaced by a newer path before they were processed
-  int64_t rejected = 0;      // bad paths (empty, non-finite, jumps, too many, too old, too far)
-  int64_t unsafe = 0;        // paths for which neither trajectory passed the clearance check
-  int64_t trajectories = 0;  // trajectories started
-  int64_t optimized = 0;     // ... of which optimised
-  int64_t fallbacks = 0;     // ... of which the fallback, because the optimised one
-  int64_t fallback_strays = 0;    //   strayed from the path (trajectory.max_deviation)
-  int64_t fallback_too_close = 0;  //  failed the clearance check
-  int64_t brakes = 0;        // predicted collisions
-  int64_t stale_stops = 0;   // entries into STALE_INPUT
+  int64_t paths = 0;               // PLAN_PATHs received
+  int64_t superseded = 0;          // replaced by a newer path before they were processed
+  int64_t rejected = 0;            // bad paths (empty, non-finite, jumps, too many, too old, too far)
+  int64_t unsafe = 0;              // paths for which neither trajectory passed the clearance check
+  int64_t trajectories = 0;        // trajectories started
+  int64_t optimized = 0;           // ... of which optimised
+  int64_t fallbacks = 0;           // ... of which the fallback, because the optimised one
+  int64_t fallback_strays = 0;     //   strayed from the path (trajectory.max_deviation)
+  int64_t fallback_too_close = 0;  //   failed the clearance check
+  int64_t brakes = 0;              // predicted collisions
+  int64_t stale_stops = 0;         // entries into STALE_INPUT
 };
 
 }  // namespace semx::controller

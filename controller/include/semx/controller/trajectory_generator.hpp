@@ -34,7 +34,7 @@ struct StartState {
 enum class FallbackCause { kNone, kOptimizerOff, kOptimizerFailed, kStrays, kTooClose };
 
 struct GenerationResult {
-  bool ok = false;        // `trajectory` is safe to fly
+  bool ok = false;  // `trajectory` is safe to fly
   FallbackCause cause = FallbackCause::kNone;
   Trajectory trajectory;  // plan_id, start_utime left to the caller
   std::string reason;     // why the fallback was used, or why there is no trajectory
@@ -65,7 +65,8 @@ class TrajectoryGenerator {
   static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline);
   static constexpr double kDeviationStep = 0.05;  // s
   // The point of the polyline nearest to p.
-  static Eigen::Vector3d nearest_on_path(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& polyline);
+  static Eigen::Vector3d nearest_on_path(const Eigen::Vector3d& p,
+                                         const std::vector<Eigen::Vector3d>& polyline);
 
   // Speed limit for a path asking for `max_speed` (0 = none).
   double speed_limit(double max_speed) const;

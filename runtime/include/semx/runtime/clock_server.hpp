@@ -31,7 +31,7 @@ struct ClockServerConfig {
   std::vector<std::string> lockstep_nodes;  // LOCKSTEP: who must ack every tick
   double resend_after_s = 0.5;
   int64_t max_slack_us = 50000;  // LOCKSTEP: a promise counts at most this far past its tick
-  int64_t max_ticks = -1;  // stop after this many ticks (-1: never)
+  int64_t max_ticks = -1;        // stop after this many ticks (-1: never)
 };
 
 struct ClockTick {
@@ -73,8 +73,8 @@ class ClockServer {
   double tick_sent_at_ = 0;
   double last_send_ = 0;
   struct NodeAcks {
-    int64_t tick = -1;         // the latest tick acked
-    int64_t quiet_until = 0;   // promised with it (capped)
+    int64_t tick = -1;        // the latest tick acked
+    int64_t quiet_until = 0;  // promised with it (capped)
   };
   bool satisfied(const std::string& node) const;
 
