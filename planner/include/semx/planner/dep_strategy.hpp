@@ -76,7 +76,9 @@ class DepStrategy : public Strategy {
   // nodes (sampling.bridge_attempts per cycle).
   void bridge(PlanContext& ctx);
   // Recovering: edges again between each unreachable node and the nearest reachable node within
-  // an edge's length, where they pass the edge check now. Returns the edges added.
+  // an edge's length, where they pass the edge check now; and approach nodes again (once per
+  // recovery) for each passage node within an edge's length of the other side of the cut.
+  // Returns the edges and approach nodes added.
   int relink(PlanContext& ctx, const Roadmap::Search& reach);
   // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
   using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
@@ -107,6 +109,7 @@ class DepStrategy : public Strategy {
   Roadmap graph_;
   int64_t root_ = -1;
   std::set<mapper::VoxelKey> changed_blocks_;  // since the last cycle
+  std::set<int64_t> reapproached_;              // passage nodes given approaches in this recovery
   // Voxels that became occupied or unknown since the last cycle, by block.
   std::map<mapper::VoxelKey, std::vector<mapper::VoxelKey>> obstacle_voxels_;
   bool full_reset_ = false;
