@@ -109,7 +109,7 @@ class DepStrategy : public Strategy {
   Roadmap graph_;
   int64_t root_ = -1;
   std::set<mapper::VoxelKey> changed_blocks_;  // since the last cycle
-  std::set<int64_t> reapproached_;              // passage nodes given approaches in this recovery
+  std::set<int64_t> reapproached_;             // passage nodes given approaches in this recovery
   // Voxels that became occupied or unknown since the last cycle, by block.
   std::map<mapper::VoxelKey, std::vector<mapper::VoxelKey>> obstacle_voxels_;
   bool full_reset_ = false;
