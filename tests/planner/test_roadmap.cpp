@@ -479,6 +479,58 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   }
 }
 
+TEST(DepRoadmap, RecoveryGivesAPassageNodeOnTheCutItsApproachesAgain) {
+  // The doorway of the test above, crossed through its passage node; then the approach node on the
+  // far side goes (a map change pruned it). The far node next to the doorway is off the line
+  // through its middle, so no edge can join them: recovery puts the approach back, once.
+  DepFixture f;
+  two_rooms_with_doorway(f.grid, 3.25, 3.85);
+  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
+  dep.plan(ctx);
+  for (const Eigen::Vector3d& q : {Eigen::Vector3d(2.0, 6.0, 1.2), Eigen::Vector3d(5.0, 6.5, 1.2)})
+    ASSERT_GE(dep.try_insert(ctx, q), -1);
+  const int64_t passage = dep.try_insert(ctx, {3.5, 4.02, 1.15});
+  ASSERT_GE(passage, 0);
+  const auto far_reached = [&] {
+    const Roadmap::Search s = dep.graph().shortest_paths(dep.root());
+    for (const RoadmapNode& n : dep.graph().slots()) {
+      if (n.alive && n.position.y() > 4.5 && s.reached(n.id)) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(far_reached());
+  std::vector<int64_t> far_approaches;
+  for (const RoadmapEdge& e : dep.graph().node(passage).edges) {
+    if (dep.graph().node(e.to).position.y() > 4.1) far_approaches.push_back(e.to);
+  }
+  ASSERT_FALSE(far_approaches.empty());
+  for (int64_t id : far_approaches) dep.graph().remove_node(id);
+  const int64_t beside = dep.graph().add_node({3.0, 5.2, 1.2});
+  for (const RoadmapNode& n : dep.graph().slots()) {
+    if (n.alive && n.id != beside && n.position.y() > 4.5) dep.graph().add_edge(beside, n.id, 1.0);
+  }
+  ASSERT_FALSE(far_reached());
+  CollisionChecker c(f.config.collision);
+  c.set_grid(&f.grid);
+  ASSERT_FALSE(c.edge_free(dep.graph().node(passage).position, {3.0, 5.2, 1.2}));
+
+  PlanContext recovering = f.context({3.55, 2.0, 1.2}, 0.0, 2);
+  recovering.recovering = true;
+  EXPECT_GT(dep.relink(recovering, dep.graph().shortest_paths(dep.root())), 0);
+  EXPECT_TRUE(far_reached());
+  // Once per recovery: the same passage node is not given approaches again.
+  for (const RoadmapEdge& e : std::vector<RoadmapEdge>(dep.graph().node(passage).edges)) {
+    if (dep.graph().node(e.to).position.y() > 4.1) dep.graph().remove_node(e.to);
+  }
+  const size_t nodes = dep.graph().num_nodes();
+  dep.relink(recovering, dep.graph().shortest_paths(dep.root()));
+  EXPECT_EQ(dep.graph().num_nodes(), nodes);
+}
+
 TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   DepFixture f;
   corridor(f.grid);
