@@ -201,15 +201,18 @@ int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   return id;
 }
 
+bool DepStrategy::link_free(PlanContext& ctx, int64_t id, const Eigen::Vector3d& p) {
+  ++ctx.counters->edges_checked;
+  const Eigen::Vector3d& q = graph_.node(id).position;
+  return id == root_ ? checker_.root_edge_free(q, p) : checker_.edge_free(p, q);
+}
+
 std::vector<std::pair<int64_t, double>> DepStrategy::free_links(PlanContext& ctx, const Eigen::Vector3d& p,
                                                                 int64_t exclude) {
   std::vector<std::pair<int64_t, double>> links;
   for (int64_t id : graph_.nearest(p, config_.roadmap.k_nearest, config_.roadmap.max_edge_length)) {
     if (id == exclude) continue;
-    const Eigen::Vector3d& q = graph_.node(id).position;
-    ++ctx.counters->edges_checked;
-    const bool free = id == root_ ? checker_.root_edge_free(q, p) : checker_.edge_free(p, q);
-    if (free) links.emplace_back(id, (q - p).norm());
+    if (link_free(ctx, id, p)) links.emplace_back(id, (graph_.node(id).position - p).norm());
   }
   return links;
 }
@@ -303,12 +306,8 @@ int DepStrategy::relink(PlanContext& ctx, const Roadmap::Search& reach) {
     if (!n.alive || static_cast<size_t>(n.id) >= reach.distance.size() || reach.reached(n.id)) continue;
     for (int64_t a : graph_.nearest(n.position, -1, radius)) {
       if (static_cast<size_t>(a) >= reach.distance.size() || !reach.reached(a)) continue;
-      const Eigen::Vector3d& p = graph_.node(a).position;
-      ++ctx.counters->edges_checked;
-      const bool free =
-          a == root_ ? checker_.root_edge_free(p, n.position) : checker_.edge_free(p, n.position);
-      if (free) {
-        graph_.add_edge(a, n.id, (p - n.position).norm());
+      if (link_free(ctx, a, n.position)) {
+        graph_.add_edge(a, n.id, (graph_.node(a).position - n.position).norm());
         ++ctx.counters->edges_added;
         ++added;
       }

@@ -388,6 +388,19 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   EXPECT_NEAR(yaws.back(), 1.0, 1e-9);
 }
 
+// Sets a wall across the corridor at x = 3 occupied; returns its changes (free -> occupied).
+std::vector<mapper::VoxelChange> wall_across_corridor(mapper::StateGrid& g) {
+  std::vector<mapper::VoxelChange> changes;
+  for (double y = 0.05; y < 4; y += 0.1) {
+    for (double z = 0.05; z < 2.5; z += 0.1) {
+      const mapper::VoxelKey k = g.keys().key(Eigen::Vector3d(3.05, y, z));
+      g.set_state(k, VoxelState::kOccupied);
+      changes.push_back({k, VoxelState::kOccupied, VoxelState::kFree});
+    }
+  }
+  return changes;
+}
+
 TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {
   DepFixture f;
   corridor(f.grid);
@@ -396,16 +409,7 @@ TEST(DepRoadmap, NewObstaclesPruneNodesAndEdges) {
   dep.on_map_reset();
   PlanContext ctx = f.context({1, 2, 1.2});
   dep.plan(ctx);
-  // A wall across the corridor at x = 3.
-  std::vector<mapper::VoxelChange> changes;
-  const mapper::KeyMath& km = f.grid.keys();
-  for (double y = 0.05; y < 4; y += 0.1)
-    for (double z = 0.05; z < 2.5; z += 0.1) {
-      const mapper::VoxelKey k = km.key(Eigen::Vector3d(3.05, y, z));
-      f.grid.set_state(k, VoxelState::kOccupied);
-      changes.push_back({k, VoxelState::kOccupied});
-    }
-  dep.on_map_changes(changes);
+  dep.on_map_changes(wall_across_corridor(f.grid));
   PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
   dep.process_map_changes(ctx2);
   EXPECT_GT(f.counters.edges_pruned + f.counters.nodes_pruned, 0);
@@ -435,15 +439,10 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   dep.on_map_reset();
   PlanContext ctx = f.context({1, 2, 1.2});
   dep.plan(ctx);
-  std::vector<mapper::VoxelChange> wall, cleared;
-  const mapper::KeyMath& km = f.grid.keys();
-  for (double y = 0.05; y < 4; y += 0.1)
-    for (double z = 0.05; z < 2.5; z += 0.1) {
-      const mapper::VoxelKey k = km.key(Eigen::Vector3d(3.05, y, z));
-      f.grid.set_state(k, VoxelState::kOccupied);
-      wall.push_back({k, VoxelState::kOccupied, VoxelState::kFree});
-      cleared.push_back({k, VoxelState::kFree, VoxelState::kOccupied});
-    }
+  const std::vector<mapper::VoxelChange> wall = wall_across_corridor(f.grid);
+  std::vector<mapper::VoxelChange> cleared;
+  for (const mapper::VoxelChange& c : wall)
+    cleared.push_back({c.key, VoxelState::kFree, VoxelState::kOccupied});
   dep.on_map_changes(wall);
   PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
   dep.process_map_changes(ctx2);

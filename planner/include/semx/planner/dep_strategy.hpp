@@ -59,6 +59,8 @@ class DepStrategy : public Strategy {
   // to p, with the edges' lengths.
   std::vector<std::pair<int64_t, double>> free_links(PlanContext& ctx, const Eigen::Vector3d& p,
                                                      int64_t exclude = -1);
+  // Whether an edge from node `id` to p passes the check (the root's rule from the root).
+  bool link_free(PlanContext& ctx, int64_t id, const Eigen::Vector3d& p);
   // Adds a node at p joined to `links`; returns its id.
   int64_t add_linked_node(PlanContext& ctx, const Eigen::Vector3d& p, bool passage,
                           const std::vector<std::pair<int64_t, double>>& links);
