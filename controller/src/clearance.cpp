@@ -38,6 +38,11 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
   const bool footprint = rule.footprint_half_xy > 0.0 && !trajectory.yaw.empty();
   double start = 0.0;
   bool escaping = false;
+  // How far below the turned body's reach a sample may be: a start already below it (the vehicle
+  // stands there), or the sample where an escape from the bound ends, may move out of it, never
+  // deeper, as an escape from the bound may.
+  double reach_deficit_allowed = 0.0;
+  bool reach_escape_may_start = true;
   for (int i = 0; i <= n; ++i) {
     const double t = n == 0 ? t0 : t0 + span * i / n;
     const Eigen::Vector3d p = trajectory.position_at(t);
@@ -61,6 +66,7 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
     if (escaping) {
       if (low >= rule.bound) {
         escaping = false;  // out: from here on the full bound applies
+        reach_escape_may_start = true;
       } else if (low < rule.hard_bound || d < start - rule.escape_slack) {
         fail(t, p, d);
         return r;
@@ -68,15 +74,23 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
     } else if (low < rule.bound) {
       fail(t, p, d);
       return r;
-    } else if (footprint && g.norm() > kMinGradient &&
-               low < footprint_reach(g.normalized(), trajectory.yaw.evaluate(t, 0)(0), rule.footprint_half_xy,
-                                     rule.footprint_half_z) +
-                         rule.footprint_margin) {
-      // The gradient points away from the nearest obstacle; the reach is symmetric.
-      r.footprint = true;
-      fail(t, p, d);
-      return r;
     }
+    if (!escaping && footprint && g.norm() > kMinGradient) {
+      // The gradient points away from the nearest obstacle; the reach is symmetric.
+      const double deficit = footprint_reach(g.normalized(), trajectory.yaw.evaluate(t, 0)(0),
+                                             rule.footprint_half_xy, rule.footprint_half_z) +
+                             rule.footprint_margin - low;
+      if (reach_escape_may_start && deficit > 0.0 && rule.allow_escape)
+        reach_deficit_allowed = deficit + rule.escape_slack;
+      if (deficit <= 0.0) {
+        reach_deficit_allowed = 0.0;  // out: from here on the full reach applies
+      } else if (deficit > reach_deficit_allowed) {
+        r.footprint = true;
+        fail(t, p, d);
+        return r;
+      }
+    }
+    reach_escape_may_start = false;
   }
   if (escaping && rule.require_exit) {
     const Eigen::Vector3d end = trajectory.position_at(t1);

@@ -83,6 +83,38 @@ TEST(Clearance, TheTurnedBodyReachesFartherTowardAWallsEnd) {
   EXPECT_NEAR(turned.violation_point.x(), 2.0, 0.15) << "where the corner meets the post";
 }
 
+TEST(Clearance, AStartWithinTheTurnedBodysReachMayMoveOutOfItButNotDeeper) {
+  // The vehicle already stands turned by 45° at 0.345 m from a post, within its corner's 0.354 m
+  // reach (env3, 35 samples, seed 3 stood so in a doorway for 550 s, every trajectory rejected at
+  // t = 0). Leaving must pass; going 2 cm nearer must not.
+  const PostField post(Eigen::Vector2d(2.0, 0.345));
+  const auto turned = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    Trajectory t = straight(a, b, 2.0);
+    t.yaw = YawSpline(YawSpline::Points(t.position.control_points().size(), YawSpline::Point(M_PI / 4)),
+                      t.position.knot_interval());
+    return t;
+  };
+  ClearanceRule rule;
+  rule.bound = 0.30;
+  rule.hard_bound = 0.25;
+  rule.footprint_half_xy = 0.25;
+  rule.footprint_half_z = 0.15;
+  const Trajectory leaving = turned({2, 0, 1}, {2, -1, 1});
+  EXPECT_TRUE(check_clearance(leaving, post, 0, leaving.duration(), rule).ok);
+  const Trajectory along = turned({2, 0, 1}, {4, 0, 1});
+  EXPECT_TRUE(check_clearance(along, post, 0, along.duration(), rule).ok);
+  const Trajectory nearer = turned({2, 0, 1}, {2, 0.02, 1});
+  const ClearanceReport r = check_clearance(nearer, post, 0, nearer.duration(), rule);
+  EXPECT_FALSE(r.ok);
+  EXPECT_TRUE(r.footprint);
+  rule.allow_escape = false;
+  EXPECT_FALSE(check_clearance(leaving, post, 0, leaving.duration(), rule).ok) << "no escape allowed";
+  // Once out of the reach, the full reach applies again: back past the post from farther away.
+  const Trajectory back = turned({2, -0.3, 1}, {2, 0.02, 1});
+  rule.allow_escape = true;
+  EXPECT_FALSE(check_clearance(back, post, 0, back.duration(), rule).ok);
+}
+
 TEST(Safety, BrakesOnAPredictedCollisionAndSaysWhy) {
   ControllerConfig cfg;
   auto free_field = boxes_field({});
