@@ -296,7 +296,8 @@ int64_t MapperNode::quiet_until(int64_t utime) const {
   if (frame == std::numeric_limits<int64_t>::min()) return utime;
   int64_t q = frame + delay;
   if (!in_flight_.empty()) q = std::min(q, in_flight_.front()->frame.utime + delay);
-  for (const auto& [next, period] : {std::pair{next_snapshot_, st.snapshot_period}, {next_stats_, st.stats_period}}) {
+  for (const auto& [next, period] :
+       {std::pair{next_snapshot_, st.snapshot_period}, {next_stats_, st.stats_period}}) {
     if (period > 0) q = std::min(q, next < 0 ? utime : next);
   }
   const double cp = mapper_.config().checkpoint.period;
@@ -307,6 +308,7 @@ int64_t MapperNode::quiet_until(int64_t utime) const {
 void MapperNode::poll_wall() {
   if (request_pending_ && std::chrono::steady_clock::now() - request_since_ >
                               std::chrono::duration<double>(options_.request_grace_s)) {
+    node_.release_promise();  // no tick came: the run is over, its frames in flight go out now
     flush_frames();
     publish_snapshot();
   }
@@ -377,6 +379,7 @@ int MapperNode::run() {
   if (node_.state() == runtime::NodeState::kStarting)
     node_.set_state(runtime::NodeState::kRunning, "waiting for frames");
   int rc = 0;
+  int silent_spins = 0;
   while (!node_.stopped()) {
     const int got = node_.spin_once(100);
     if (got < 0) {
@@ -384,11 +387,18 @@ int MapperNode::run() {
       rc = 1;
       break;
     }
-    // 100 ms without a message while frames are in flight: the clock stopped (the simulator
-    // ended), so no tick will publish them.
-    if (got == 0 && !in_flight_.empty()) flush_frames();
+    silent_spins = got == 0 ? silent_spins + 1 : 0;
+    // 1 s without any message while frames are in flight: the clock stopped (the simulator
+    // ended), so no tick will publish them. A clock that waits for a slow node resends its tick
+    // every 0.5 s, so a stall is never that silent (100 ms was: a run's first ticks, waiting
+    // for a starting node, had frames published before the mapper's promised tick).
+    if (silent_spins >= 10 && !in_flight_.empty()) {
+      node_.release_promise();
+      flush_frames();
+    }
     poll_wall();
   }
+  node_.release_promise();  // the run is over: what is in flight goes out now
   flush_frames();
   checkpoint_now();
   if (rc == 0)

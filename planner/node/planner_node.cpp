@@ -34,7 +34,10 @@ PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& conf
   node_.on_quiet_until([this](int64_t utime) {
     // A mirror out of sync may request a snapshot on any tick.
     if (!map_->in_sync() || last_status_utime_ < 0) return utime;
-    return std::min(planner_.quiet_until(utime), last_status_utime_ + kStatusPeriodUs);
+    // A cycle run after this ack releases nothing before its least charge.
+    const int64_t next =
+        deferred_cycle_utime_ == utime ? utime + planner_.min_charge_us() : planner_.quiet_until(utime);
+    return std::min(next, last_status_utime_ + kStatusPeriodUs);
   });
   node_.set_state(runtime::NodeState::kRunning,
                   std::string(to_string(planner_.kind())) + ": waiting for the map");
@@ -50,7 +53,19 @@ void PlannerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   // A mirror waiting for a snapshot is not the mapper's map: no planning on it (the planner
   // starts over from the map it gets back, as after any reset).
   planner_.set_map(map_->in_sync() ? &map_->mirror().grid() : nullptr);
-  ExplorationPlanner::Output out = planner_.tick(utime);
+  // With a least charge the cycle's outputs go out on a later tick, so it runs after this tick's
+  // ack and the clock goes on meanwhile (in LOCKSTEP; at once otherwise).
+  bool due = false;
+  ExplorationPlanner::Output out =
+      planner_.min_charge_us() > 0 ? planner_.poll(utime, due) : planner_.tick(utime);
+  if (due) {
+    deferred_cycle_utime_ = utime;
+    node_.after_ack([this, utime] {
+      planner_.run_due_cycle(utime);
+      deferred_cycle_utime_ = -1;
+      if (planner_.state() != reported_state_) update_node_state();
+    });
+  }
   if (out.path) node_.publish(semx::channels::PLAN_PATH, to_message(*out.path, utime));
   if (out.roadmap) node_.publish(semx::channels::ROADMAP, to_message(*out.roadmap, utime));
   if (out.status) {

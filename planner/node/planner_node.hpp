@@ -42,6 +42,7 @@ class PlannerNode {
   ExplorationPlanner planner_;
   int64_t last_utime_ = -1;
   int64_t last_status_utime_ = -1;
+  int64_t deferred_cycle_utime_ = -1;  // a cycle due at this tick runs after its ack
   PlannerState reported_state_ = PlannerState::kInit;
 };
 

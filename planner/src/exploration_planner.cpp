@@ -187,7 +187,23 @@ StatusReport ExplorationPlanner::make_status(PlannerState state, const std::stri
 }
 
 ExplorationPlanner::Output ExplorationPlanner::tick(int64_t utime) {
+  bool due = false;
+  Output out = poll(utime, due);
+  if (!due) return out;
+  run_cycle(utime);
+  if (pending_.active && utime >= pending_.ready_utime) release(out, utime);
+  return out;
+}
+
+void ExplorationPlanner::run_due_cycle(int64_t utime) { run_cycle(utime); }
+
+int64_t ExplorationPlanner::min_charge_us() const {
+  return static_cast<int64_t>(std::llround(config_.charge.scale * config_.charge.min_s * 1e6));
+}
+
+ExplorationPlanner::Output ExplorationPlanner::poll(int64_t utime, bool& cycle_due) {
   Output out;
+  cycle_due = false;
   if (pending_.active) {
     if (utime >= pending_.ready_utime) release(out, utime);
     return out;
@@ -202,9 +218,7 @@ ExplorationPlanner::Output ExplorationPlanner::tick(int64_t utime) {
     }
     return out;
   }
-  if (next_cycle_utime_ >= 0 && utime < next_cycle_utime_) return out;
-  run_cycle(utime);
-  if (pending_.active && utime >= pending_.ready_utime) release(out, utime);
+  cycle_due = next_cycle_utime_ < 0 || utime >= next_cycle_utime_;
   return out;
 }
 

@@ -122,6 +122,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
 
   auto ch = m.child("charge");
   ch.get("base_s", c.charge.base_s, 0.0, 1e3);
+  ch.get("min_s", c.charge.min_s, 0.0, 1e3);
   ch.get("per_box_check_s", c.charge.per_box_check_s, 0.0, 1.0);
   ch.get("per_gain_node_s", c.charge.per_gain_node_s, 0.0, 1.0);
   ch.get("per_ray_step_s", c.charge.per_ray_step_s, 0.0, 1.0);

@@ -204,7 +204,8 @@ void Node::note_handler_error(const std::string& channel, const char* what) {
 }
 
 bool Node::publish_raw(const std::string& channel, const void* data, std::size_t size) {
-  if (quiet_until_ > 0 && !may_publish() && channel != channels::NODE_STATUS && channel != channels::SIM_ACK) {
+  if (quiet_until_ > 0 && !may_publish() && channel != channels::NODE_STATUS &&
+      channel != channels::SIM_ACK) {
     ++early_publishes_;
     if (worth_logging(early_publishes_)) {
       std::cerr << options_.name << ": published " << channel << " at utime " << clock_.now_utime()
@@ -233,7 +234,10 @@ void Node::on_clock_message(const semx::clock_t& msg) {
     for (auto& fn : tick_handlers_) fn(msg.tick, msg.utime);
     in_tick_ = false;
   }
-  if (decision.ack) {
+  const bool skip_ack = decision.new_tick && !decision.reset && quiet_until_ > msg.utime &&
+                        last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
+                        msg.utime - last_ack_utime_ < kAckIntervalUs;
+  if (decision.ack && !skip_ack) {
     semx::ack_t ack;
     ack.utime = msg.utime;
     ack.node = options_.name;
@@ -241,7 +245,11 @@ void Node::on_clock_message(const semx::clock_t& msg) {
     ack.quiet_until = quiet_until_fn_ ? quiet_until_fn_(msg.utime) : 0;
     publish(channels::SIM_ACK, ack);
     quiet_until_ = ack.quiet_until;
+    last_ack_utime_ = msg.utime;
   }
+  std::vector<std::function<void()>> work;
+  work.swap(after_ack_);
+  for (auto& fn : work) fn();
 }
 
 bool Node::may_publish() const {

@@ -1,6 +1,7 @@
 #include "semantics_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "semantics_messages.hpp"
@@ -14,6 +15,7 @@ SemanticsNode::SemanticsNode(runtime::NodeOptions options, const SemanticsConfig
       pipeline_(config),
       publisher_(config.regions),
       gate_(config.detector.frame_period_s) {
+  latency_us_ = static_cast<int64_t>(std::llround(config.detector.latency_s * 1e6));
   need_labels_ = pipeline_.detector().needs_labels();
   need_rgb_ = pipeline_.detector().needs_rgb();
   // Captures that are not due are dropped from their bytes' utime, before the 0.3-1 MB images
@@ -73,14 +75,17 @@ SemanticsNode::SemanticsNode(runtime::NodeOptions options, const SemanticsConfig
         },
         accept_rgb);
   }
-  node_.on_tick([this](int64_t, int64_t utime) { maybe_publish(utime); });
+  node_.on_tick([this](int64_t, int64_t utime) { on_tick(utime); });
   // Regions change only when a frame is processed, so nothing is published before the next frame
-  // the gate takes or the periodic repeat.
+  // the gate takes (plus the latency) or the periodic repeat; a processed frame's regions wait
+  // for publish_at_, and so does the repeat.
   node_.on_quiet_until([this](int64_t utime) {
+    if (deferred_) return deferred_->utime + latency_us_;
+    if (publish_at_ >= 0) return publish_at_;
     const int64_t frame = gate_.next_due();
     const int64_t repeat = publisher_.next_repeat_utime();
     if (frame == std::numeric_limits<int64_t>::min() || counters_.frames_processed == 0) return utime;
-    return repeat < 0 ? frame : std::min(frame, repeat);
+    return repeat < 0 ? frame + latency_us_ : std::min(frame + latency_us_, repeat);
   });
   node_.set_state(runtime::NodeState::kRunning, "waiting for camera frames");
 }
@@ -115,8 +120,29 @@ void SemanticsNode::complete(int64_t frame_id) {
   if (it == pending_.end()) return;
   const Pending& p = it->second;
   if (!p.depth || (need_labels_ && !p.labels) || (need_rgb_ && !p.rgb)) return;
-  const Frame frame = std::move(it->second.frame);
+  Frame frame = std::move(it->second.frame);
   pending_.erase(it);
+  if (latency_us_ > 0) {
+    if (deferred_) process(*deferred_);  // two frames before one tick: the first one now
+    deferred_ = std::move(frame);
+    return;
+  }
+  process(frame);
+}
+
+void SemanticsNode::on_tick(int64_t utime) {
+  if (publish_at_ >= 0 && utime >= publish_at_) publish_at_ = -1;
+  if (publish_at_ < 0) maybe_publish(utime);
+  if (!deferred_) return;
+  node_.after_ack([this] {
+    if (!deferred_) return;
+    const Frame frame = std::move(*deferred_);
+    deferred_.reset();
+    process(frame);
+  });
+}
+
+void SemanticsNode::process(const Frame& frame) {
   const FrameStats s = pipeline_.process(frame);
   counters_.process_ms += s.total_ms();
   if (!s.accepted) {
@@ -126,7 +152,12 @@ void SemanticsNode::complete(int64_t frame_id) {
   }
   ++counters_.frames_processed;
   gate_.taken(frame.utime);
-  maybe_publish(frame.utime);
+  if (latency_us_ > 0) {
+    // Frames closer than the latency (detector.frame_period_s = 0) go out with the first one's.
+    if (publish_at_ < 0) publish_at_ = frame.utime + latency_us_;
+  } else {
+    maybe_publish(frame.utime);
+  }
 }
 
 void SemanticsNode::maybe_publish(int64_t utime) {

@@ -9,10 +9,11 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 
+#include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/node.hpp"
 #include "semx/semantics/config.hpp"
-#include "semx/runtime/frame_gate.hpp"
 #include "semx/semantics/pipeline.hpp"
 #include "semx/semantics/regions.hpp"
 
@@ -56,6 +57,8 @@ class SemanticsNode {
   };
   Pending* part(const semx::camera_info_t& info, int64_t utime);
   void complete(int64_t frame_id);
+  void process(const Frame& frame);
+  void on_tick(int64_t utime);
   void maybe_publish(int64_t utime);
   void update_state();
 
@@ -66,6 +69,11 @@ class SemanticsNode {
   runtime::FrameGate gate_;
   bool need_labels_, need_rgb_;
   std::map<int64_t, Pending> pending_;
+  // detector.latency_s > 0: the complete frame waiting for its tick's ack, and the message time
+  // from which what it changed may go out (-1: none).
+  int64_t latency_us_ = 0;
+  std::optional<Frame> deferred_;
+  int64_t publish_at_ = -1;
   uint64_t arrivals_ = 0;
   SemanticsNodeCounters counters_;
   std::string last_reject_;

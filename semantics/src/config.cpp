@@ -57,6 +57,7 @@ void load(runtime::ConfigMap& m, SemanticsConfig& c) {
   d.get("morph_kernel_px", c.detector.morph_kernel_px, 1, 31);
   if (c.detector.morph_kernel_px % 2 == 0) d.fail("morph_kernel_px", "must be odd");
   d.get("frame_period_s", c.detector.frame_period_s, 0.0, 3600.0);
+  d.get("latency_s", c.detector.latency_s, 0.0, 10.0);
   auto dnn = d.child("dnn");
   load_dnn(dnn, c.detector.dnn);
   if (c.detector.type == "dnn" && c.detector.dnn.model.empty()) {

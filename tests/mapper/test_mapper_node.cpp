@@ -425,7 +425,7 @@ TEST(MapperNode, DefaultFramePeriodIntegratesTenFramesASecond) {
   EXPECT_EQ(mn.frames_malformed(), 0);
 }
 
-// streaming.lockstep_delay (default 0.04 s): in LOCKSTEP a frame is integrated on the worker and
+// streaming.lockstep_delay (here 0.04 s): in LOCKSTEP a frame is integrated on the worker and
 // its outputs go out in the handler of the first tick 0.04 s after it, before that tick's ack;
 // they are exactly the outputs of the synchronous node. A tick with stats due publishes every
 // frame in flight first, so MAP_STATS describes the map of the last MAP_UPDATE.
@@ -434,7 +434,7 @@ TEST(MapperNode, LockstepDelayPublishesAFramesOutputsAtAFixedLaterTick) {
   const auto frames = test::room_frames(4, cam, 4);
   MapperConfig cfg = small_config();
   cfg.streaming.stats_period = 0.15;
-  ASSERT_DOUBLE_EQ(cfg.streaming.lockstep_delay, 0.04);
+  cfg.streaming.lockstep_delay = 0.04;
   runtime::Node node(memq_node("mapper", /*lockstep=*/true));
   Wire wire(node);
   MapperNode mn(node, cfg);

@@ -67,6 +67,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(loop.visited_cycles);
   SAME(loop.max_start_offset);
   SAME(charge.base_s);
+  SAME(charge.min_s);
   SAME(charge.per_box_check_s);
   SAME(charge.per_gain_node_s);
   SAME(charge.per_ray_step_s);

@@ -215,6 +215,44 @@ TEST(Planner, PlanningTimeIsChargedBeforeThePathGoesOut) {
   EXPECT_TRUE(r.tick(0).path);
 }
 
+TEST(Planner, NoCycleIsChargedLessThanMinAndTheTwoStepTickAgrees) {
+  mapper::StateGrid g = corridor();
+  PlannerConfig c = test_config();
+  c.charge.min_s = 2.0;  // far more than this cycle's work
+  ExplorationPlanner p(c);
+  p.set_map(&g);
+  p.set_pose(pose({1, 2, 1.2}));
+  int64_t when = 0;
+  const auto path = first_path(p, 1000000, 5000000, &when);
+  ASSERT_TRUE(path);
+  EXPECT_DOUBLE_EQ(p.last_status().charged_s, 2.0);
+  EXPECT_EQ(when, 3000000);
+  // A node that acks the tick before the cycle (poll, then run_due_cycle after the ack) gets the
+  // same path at the same tick, and can promise quiet for the least charge meanwhile.
+  ExplorationPlanner q(c);
+  q.set_map(&g);
+  q.set_pose(pose({1, 2, 1.2}));
+  EXPECT_EQ(q.min_charge_us(), 2000000);
+  int64_t when_q = -1;
+  std::optional<PlannedPath> path_q;
+  for (int64_t t = 1000000; t <= 5000000 && !path_q; t += 10000) {
+    bool due = false;
+    const auto out = q.poll(t, due);
+    if (out.path) {
+      path_q = out.path;
+      when_q = t;
+    }
+    if (due) {
+      EXPECT_EQ(t, 1000000) << "one cycle, then its release";
+      q.run_due_cycle(t);
+      EXPECT_GE(q.quiet_until(t), t + q.min_charge_us());
+    }
+  }
+  ASSERT_TRUE(path_q);
+  EXPECT_EQ(when_q, when);
+  EXPECT_EQ(path_q->waypoints, path->waypoints);
+}
+
 // The planner on the corridor map with the vehicle at (1, 2, 1.2), after its first path (at t).
 struct CorridorStart {
   mapper::StateGrid g = corridor();

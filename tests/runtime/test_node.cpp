@@ -184,6 +184,40 @@ TEST(Node, LockstepNodeDoesTickWorkThenAcks) {
   EXPECT_EQ(n.now_utime(), 20000);
 }
 
+TEST(Node, WithinItsPromiseANodeAcksOnlyEvery50msAndRunsDeferredWorkAfterTheAck) {
+  Node n(memq("planner", true));
+  int64_t promise = 0;  // what the node says at each ack
+  n.on_quiet_until([&](int64_t) { return promise; });
+  std::vector<std::string> order;
+  n.on_tick([&](int64_t tick, int64_t) {
+    if (tick == 2) {
+      n.after_ack([&] {
+        order.push_back("work2 after " + std::to_string(n.outgoing().at("SIM_ACK").messages) + " acks");
+      });
+    }
+  });
+  n.subscribe<semx::ack_t>("SIM_ACK",
+                           [&](const semx::ack_t& a) { order.push_back("ack" + std::to_string(a.tick)); });
+  auto tick = [&](int64_t k) {
+    semx::clock_t c{};
+    c.utime = k * 10000;
+    c.tick = k;
+    c.mode = semx::clock_t::LOCKSTEP;
+    n.publish("SIM_CLOCK", c);
+    drain(n);
+  };
+  tick(0);
+  tick(1);
+  promise = 250000;  // quiet until 0.25 s, said with the ack of tick 2
+  tick(2);
+  for (int64_t k = 3; k <= 26; ++k) tick(k);
+  tick(26);  // the clock resends a tick it waits for: always acked
+  // Ticks 3-6 and 8-11 fall inside the promise and within 50 ms of the last ack; 7 and 12 are
+  // 50 ms after one; from 25 (0.25 s) on the promise is over and every tick is acked.
+  EXPECT_EQ(order, (std::vector<std::string>{"ack0", "ack1", "work2 after 3 acks", "ack2", "ack7", "ack12",
+                                             "ack17", "ack22", "ack25", "ack26", "ack26"}));
+}
+
 TEST(Node, StatusCarriesCountersAndState) {
   Node n(memq("statusy"));
   std::vector<semx::node_status_t> seen;

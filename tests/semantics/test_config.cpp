@@ -18,6 +18,7 @@ TEST(SemanticsConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(detector.min_area_px);
   SAME(detector.morph_kernel_px);
   SAME(detector.frame_period_s);
+  SAME(detector.latency_s);
   SAME(detector.dnn.model);
   SAME(detector.dnn.input_width);
   SAME(detector.dnn.input_height);

@@ -102,6 +102,25 @@ TEST(SemanticsNode, FramesInRegionsOut) {
   EXPECT_EQ(back[0].id, r.id);
 }
 
+TEST(SemanticsNode, RegionsGoOutTheDetectorsLatencyAfterTheirFrame) {
+  Harness h;  // detector.latency_s = 0.05: the frame is processed after its tick's ack
+  h.step();
+  EXPECT_EQ(h.sn.counters().frames_processed, 1);
+  EXPECT_TRUE(h.published.empty());
+  h.clock(h.utime + 40000);
+  EXPECT_TRUE(h.published.empty()) << "still within the latency";
+  h.clock(h.utime + 50000);
+  ASSERT_EQ(h.published.size(), 1u);
+  EXPECT_EQ(h.published[0].utime, h.utime + 50000);
+  // Without latency the regions go out with the frame's own tick.
+  SemanticsConfig c;
+  c.detector.latency_s = 0;
+  Harness g(c);
+  g.step();
+  ASSERT_EQ(g.published.size(), 1u);
+  EXPECT_EQ(g.published[0].utime, g.utime);
+}
+
 TEST(SemanticsNode, RepublishesEverySecondOfMessageTimeWithoutChanges) {
   Harness h;
   for (int k = 0; k < 30; ++k) h.step();

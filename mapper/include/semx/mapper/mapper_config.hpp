@@ -70,9 +70,10 @@ struct StreamingParams {
   // LOCKSTEP only: a frame is integrated (and its ESDF computed) on a worker thread while the
   // simulator and the other nodes go on, and its MAP_UPDATE / ESDF_LOCAL are published by the
   // first tick at least this long after the frame (message time, so every run publishes them at
-  // the same tick). 0 = in the frame's handler, before the ack of the frame's own tick. 0.04 s
-  // spans the next camera frame at 30 Hz, so its rendering overlaps this frame's integration.
-  double lockstep_delay = 0.04;
+  // the same tick). 0 = in the frame's handler, before the ack of the frame's own tick. 0.09 s:
+  // the integration overlaps the other nodes' next 9 ticks, within the clock's 0.1 s max_slack
+  // (env3's first 120 s: 26.0 s of wall time against 27.0 s with 0.04 s; docs/runtime.md).
+  double lockstep_delay = 0.09;
 };
 
 struct CheckpointParams {

@@ -67,6 +67,13 @@ class ExplorationPlanner {
     std::optional<RoadmapView> roadmap;
   };
   Output tick(int64_t utime);
+  // tick() in two steps, for a node that acks the tick before the cycle's work: poll() does all
+  // tick() does but run a due cycle, and says whether one is due; run_due_cycle() then runs it.
+  // Its outputs wait for a later tick when min_charge_us() is at least a tick.
+  Output poll(int64_t utime, bool& cycle_due);
+  void run_due_cycle(int64_t utime);
+  // The least a cycle is charged (charge.scale · charge.min_s), in µs.
+  int64_t min_charge_us() const;
   // The earliest message time at which tick() can output anything, whatever arrives before it
   // (the next cycle or release; `utime` when that depends on what arrives).
   int64_t quiet_until(int64_t utime) const;

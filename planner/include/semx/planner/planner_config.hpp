@@ -61,7 +61,7 @@ struct CollisionConfig {
 
 // Where candidate nodes are drawn.
 struct SamplingConfig {
-  int samples = 45;                // candidates kept per cycle at most: the paper's sampling density
+  int samples = 45;  // candidates kept per cycle at most: the paper's sampling density
   // Candidates per cycle drawn between unreachable roadmap parts and the reachable one (through
   // the doorway between them; DepStrategy::bridge); 0 disables.
   int bridge_attempts = 20;
@@ -138,12 +138,16 @@ struct LoopConfig {
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").
 struct ChargeConfig {
-  double base_s = 0.0;                // per cycle
-  double per_box_check_s = 5.0e-7;    // per vehicle-box collision check (nodes and edge samples)
-  double per_gain_node_s = 0.0;       // per gain evaluation
-  double per_ray_step_s = 7.0e-9;     // per voxel stepped by a gain ray
-  double per_search_node_s = 0.0;     // per node settled by the graph search
-  double scale = 1.0;                 // multiplies everything (0: planning is free)
+  double base_s = 0.0;  // per cycle
+  // s, no cycle is charged less: its inputs, outputs and scheduling take time the fit leaves out
+  // (as the mapper's streaming.lockstep_delay), and a LOCKSTEP node runs the cycle after acking
+  // its tick while the clock goes on this far (docs/planner.md, "Planning time").
+  double min_s = 0.1;
+  double per_box_check_s = 5.0e-7;  // per vehicle-box collision check (nodes and edge samples)
+  double per_gain_node_s = 0.0;     // per gain evaluation
+  double per_ray_step_s = 7.0e-9;   // per voxel stepped by a gain ray
+  double per_search_node_s = 0.0;   // per node settled by the graph search
+  double scale = 1.0;               // multiplies everything (0: planning is free)
 };
 
 // Receding-horizon NBV (Bircher 2016).

@@ -30,8 +30,8 @@ struct ClockServerConfig {
   double max_speed = 0.0;     // LOCKSTEP: never faster than this many simulated s per wall s (0: no cap)
   std::vector<std::string> lockstep_nodes;  // LOCKSTEP: who must ack every tick
   double resend_after_s = 0.5;
-  int64_t max_slack_us = 50000;  // LOCKSTEP: a promise counts at most this far past its tick
-  int64_t max_ticks = -1;        // stop after this many ticks (-1: never)
+  int64_t max_slack_us = 100000;  // LOCKSTEP: a promise counts at most this far past its tick
+  int64_t max_ticks = -1;         // stop after this many ticks (-1: never)
 };
 
 struct ClockTick {

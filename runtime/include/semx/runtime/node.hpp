@@ -106,6 +106,10 @@ class Node {
   void on_tick(std::function<void(int64_t tick, int64_t utime)> fn) {
     tick_handlers_.push_back(std::move(fn));
   }
+  // From a tick handler: run `fn` after this tick's ack (at once when nothing is acked), so the
+  // clock can go on meanwhile up to the promised quiet_until. Work that publishes nothing before
+  // its promise (a planning cycle whose outputs are charged time) then overlaps other nodes'.
+  void after_ack(std::function<void()> fn) { after_ack_.push_back(std::move(fn)); }
   const SimClock& clock() const { return clock_; }
   int64_t now_utime() const { return clock_.now_utime(); }
   // LOCKSTEP: asked after the tick handlers, before each ack: the earliest message time at which
@@ -114,7 +118,15 @@ class Node {
   // for this node on the ticks before it. Without one (or <= the tick), every tick is waited for.
   // A node must keep its promise: may_publish() says whether the current tick is past it.
   void on_quiet_until(std::function<int64_t(int64_t utime)> fn) { quiet_until_fn_ = std::move(fn); }
+  // Within its promise a node acks a new tick only every kAckIntervalUs of message time: the clock
+  // does not wait for those acks, and each one woke every process on the bus (five a tick were
+  // half the run's messages). The clock counts a promise at most ClockServerConfig::max_slack_us
+  // (100 ms) past the acked tick, so it never waits for a skipped one. Resent ticks are acked.
+  static constexpr int64_t kAckIntervalUs = 50000;
   bool may_publish() const;
+  // Drops this node's last promise: for a node that saw no tick for a while of wall time (the
+  // simulator ended) and must answer anyway (the mapper's last snapshot request).
+  void release_promise() { quiet_until_ = 0; }
   // Publications on ticks this node had promised to be quiet (a broken promise makes a lockstep
   // run depend on scheduling); NODE_STATUS and SIM_ACK do not count.
   int64_t early_publishes() const { return early_publishes_; }
@@ -162,6 +174,8 @@ class Node {
   std::vector<uint8_t> encode_buffer_;
   std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;
   std::function<int64_t(int64_t)> quiet_until_fn_;
+  std::vector<std::function<void()>> after_ack_;
+  int64_t last_ack_utime_ = -1;
   int64_t quiet_until_ = 0;  // the promise sent with the last ack
   int64_t tick_period_us_ = 0;
   bool in_tick_ = false;

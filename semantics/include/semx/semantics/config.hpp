@@ -36,6 +36,10 @@ struct DetectorConfig {
   int morph_kernel_px = 3;  // square opening kernel (1 = no clean-up)
   // At most one frame per this much message time is processed (0 = every frame); see FrameGate.
   double frame_period_s = 0.1;
+  // s of message time from a frame to the regions it changes: a detector's latency, as the
+  // mapper's streaming.lockstep_delay. The frame is processed after its tick's ack, so in LOCKSTEP
+  // the clock goes on meanwhile (0 = processed and published before the ack).
+  double latency_s = 0.05;
   DnnConfig dnn;
 };
 
