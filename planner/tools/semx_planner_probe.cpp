@@ -1,10 +1,11 @@
 // semx-planner-probe: what the planner's collision checks say about doorways on a real map (a
-// mapper checkpoint, e.g. from semx-map-replay or semx-mapper --checkpoint). For each doorway it
+// mapper checkpoint, e.g. from semx-map-replay or semx-mapper --checkpoint, or a run folder's
+// map.bt: a checkpoint changes when the mapper publishes, and so the run). For each doorway it
 // prints horizontal slices of the voxel states with the points where a roadmap node may stand,
 // and how many straight edges through the doorway pass the edge check. Debugging aid for
 // "the roadmap never connects this room" (docs/planner.md, "Narrow passages").
 //
-//   semx-planner-probe MAP.ckpt [--door X,Y,AXIS]... [--set KEY=VALUE]...
+//   semx-planner-probe MAP.ckpt|map.bt [--door X,Y,AXIS]... [--edge ...]... [--set KEY=VALUE]...
 //
 // AXIS is the axis the wall runs along (x: a wall of constant y, crossed along y). Without
 // --door, env3's doorways.
@@ -13,6 +14,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <octomap/OcTree.h>
 
 #include "semx/mapper/checkpoint.hpp"
 #include "semx/mapper/occupancy_map.hpp"
@@ -24,6 +27,32 @@
 using namespace semx;
 
 namespace {
+
+// A run folder's map.bt (the evaluator's copy of the map: each known voxel at the clamping
+// log-odds of its state) as voxel states.
+void load_bt(const std::string& path, mapper::StateGrid& grid) {
+  octomap::OcTree tree(0.1);
+  if (!tree.readBinary(path)) throw runtime::ConfigError(path + ": not an OctoMap binary tree");
+  const double res = tree.getResolution();
+  if (std::abs(res - grid.resolution()) > 1e-9)
+    throw runtime::ConfigError(path + ": resolution " + std::to_string(res) +
+                               ", the planner's map has 0.1 m");
+  const mapper::KeyMath km(res);
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    const mapper::VoxelState s =
+        tree.isNodeOccupied(*it) ? mapper::VoxelState::kOccupied : mapper::VoxelState::kFree;
+    const int n = static_cast<int>(std::lround(it.getSize() / res));  // a pruned leaf spans n^3 voxels
+    const octomap::point3d c = it.getCoordinate();
+    const Eigen::Vector3d lo(c.x() - 0.5 * it.getSize() + 0.5 * res, c.y() - 0.5 * it.getSize() + 0.5 * res,
+                             c.z() - 0.5 * it.getSize() + 0.5 * res);
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          mapper::VoxelKey k;
+          if (km.key(lo + Eigen::Vector3d(x, y, z) * res, k)) grid.set_state(k, s);
+        }
+  }
+}
 
 struct Door {
   double x, y;
@@ -144,7 +173,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> doors, overrides, edges;
     runtime::ArgParser p("semx-planner-probe",
                          "Prints the planner's collision checks around doorways of a mapper checkpoint.");
-    p.positional("MAP", "mapper checkpoint (map.ckpt)", &ckpt)
+    p.positional("MAP", "mapper checkpoint (map.ckpt), or a run folder's map.bt", &ckpt)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
         .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors)
@@ -153,9 +182,16 @@ int main(int argc, char** argv) {
     if (!p.parse(argc, argv)) return 0;
     const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
     mapper::OccupancyMap map{mapper::OccupancyParams()};
-    mapper::load_checkpoint(ckpt, map);
+    mapper::StateGrid bt_grid(map.grid().resolution());
+    const bool bt = ckpt.size() > 3 && ckpt.compare(ckpt.size() - 3, 3, ".bt") == 0;
+    if (bt) {
+      load_bt(ckpt, bt_grid);
+    } else {
+      mapper::load_checkpoint(ckpt, map);
+    }
+    const mapper::StateGrid& grid = bt ? bt_grid : grid;
     planner::CollisionChecker checker(config.collision);
-    checker.set_grid(&map.grid());
+    checker.set_grid(&grid);
     std::vector<Door> list;
     for (const std::string& s : doors) {
       Door d{};
@@ -176,7 +212,7 @@ int main(int argc, char** argv) {
         return 2;
       }
       const auto state = [&](const Eigen::Vector3d& q) {
-        const mapper::VoxelState v = map.grid().state(q);
+        const mapper::VoxelState v = grid.state(q);
         return v == mapper::VoxelState::kFree       ? "free"
                : v == mapper::VoxelState::kOccupied ? "occupied"
                                                     : "unknown";
@@ -193,7 +229,7 @@ int main(int argc, char** argv) {
       list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'}, {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
               {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'}, {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};
     }
-    for (const Door& d : list) probe(map.grid(), checker, d);
+    for (const Door& d : list) probe(grid, checker, d);
     return 0;
   });
 }

@@ -530,6 +530,30 @@ TEST(DepRoadmap, RecoveryGivesAPassageNodeOnTheCutItsApproachesAgain) {
   EXPECT_EQ(dep.graph().num_nodes(), nodes);
 }
 
+TEST(DepRoadmap, RecoveryPutsAPassageNodeInADoorwayCrowdedByNodesOnBothSides) {
+  // Nodes 0.3 m before and after the doorway, none in it: a draw centred in the doorway is
+  // within min_node_distance (0.5 m) of both and was always dropped, so the rooms stayed apart
+  // (env3, seed 2: DONE at 69 %). While recovering it is kept as a passage node.
+  DepFixture f;
+  two_rooms_with_doorway(f.grid, 3.25, 3.85);
+  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);
+  f.frontiers.reset(f.grid);
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
+  dep.plan(ctx);
+  dep.graph().add_node({3.55, 3.7, 1.15});
+  dep.graph().add_node({3.55, 4.35, 1.15});
+  EXPECT_EQ(dep.try_insert(ctx, {3.5, 4.02, 1.15}), -1);
+  PlanContext recovering = f.context({3.55, 2.0, 1.2}, 0.0, 2);
+  recovering.recovering = true;
+  const int64_t id = dep.try_insert(recovering, {3.5, 4.02, 1.15});
+  ASSERT_GE(id, 0);
+  EXPECT_TRUE(dep.graph().node(id).passage);
+  // Not on top of an existing node, though.
+  EXPECT_EQ(dep.try_insert(recovering, dep.graph().node(id).position + Eigen::Vector3d(0.05, 0, 0)), -1);
+}
+
 TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   DepFixture f;
   corridor(f.grid);

@@ -37,6 +37,8 @@ namespace semx::planner {
 class DepStrategy : public Strategy {
  public:
   DepStrategy(const PlannerConfig& config, bool semantic);
+  // m: while recovering, a passage node may stand this close to other nodes (try_insert).
+  static constexpr double kPassageSpacing = 0.15;
 
   void on_map_changes(const std::vector<mapper::VoxelChange>& changes) override;
   void on_map_reset() override;
