@@ -104,6 +104,7 @@ TEST(SemanticsNode, FramesInRegionsOut) {
 
 TEST(SemanticsNode, RegionsGoOutTheDetectorsLatencyAfterTheirFrame) {
   Harness h;  // detector.latency_s = 0.05: the frame is processed after its tick's ack
+  h.clock(0);
   h.step();
   EXPECT_EQ(h.sn.counters().frames_processed, 1);
   EXPECT_TRUE(h.published.empty());
@@ -116,9 +117,17 @@ TEST(SemanticsNode, RegionsGoOutTheDetectorsLatencyAfterTheirFrame) {
   SemanticsConfig c;
   c.detector.latency_s = 0;
   Harness g(c);
+  g.clock(0);
   g.step();
   ASSERT_EQ(g.published.size(), 1u);
   EXPECT_EQ(g.published[0].utime, g.utime);
+  // Without a clock (frames fed by hand) no tick would come: at once.
+  Harness n;
+  const auto f = n.capture();
+  n.send(ch::CAMERA_DEPTH, semx::simulator::depth_message(f, ImageCompression::kNone));
+  n.send(ch::CAMERA_LABELS, semx::simulator::label_message(f, ImageCompression::kRle));
+  EXPECT_EQ(n.sn.counters().frames_processed, 1);
+  EXPECT_EQ(n.published.size(), 1u);
 }
 
 TEST(SemanticsNode, RepublishesEverySecondOfMessageTimeWithoutChanges) {
