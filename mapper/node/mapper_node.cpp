@@ -237,6 +237,11 @@ void MapperNode::publish_done(int64_t up_to_utime) {
 
 void MapperNode::flush_frames() { publish_done(std::numeric_limits<int64_t>::max()); }
 
+void MapperNode::flush_without_clock() {
+  node_.release_promise();
+  flush_frames();
+}
+
 bool MapperNode::periodic_due() const {
   const StreamingParams& st = mapper_.config().streaming;
   const double cp = mapper_.config().checkpoint.period;
@@ -308,8 +313,7 @@ int64_t MapperNode::quiet_until(int64_t utime) const {
 void MapperNode::poll_wall() {
   if (request_pending_ && std::chrono::steady_clock::now() - request_since_ >
                               std::chrono::duration<double>(options_.request_grace_s)) {
-    node_.release_promise();  // no tick came: the run is over, its frames in flight go out now
-    flush_frames();
+    flush_without_clock();
     publish_snapshot();
   }
 }
@@ -392,14 +396,10 @@ int MapperNode::run() {
     // ended), so no tick will publish them. A clock that waits for a slow node resends its tick
     // every 0.5 s, so a stall is never that silent (100 ms was: a run's first ticks, waiting
     // for a starting node, had frames published before the mapper's promised tick).
-    if (silent_spins >= 10 && !in_flight_.empty()) {
-      node_.release_promise();
-      flush_frames();
-    }
+    if (silent_spins >= 10 && !in_flight_.empty()) flush_without_clock();
     poll_wall();
   }
-  node_.release_promise();  // the run is over: what is in flight goes out now
-  flush_frames();
+  flush_without_clock();
   checkpoint_now();
   if (rc == 0)
     node_.set_state(runtime::NodeState::kStopping, runtime::shutdown_requested() ? "signal" : "stopped");

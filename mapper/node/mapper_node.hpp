@@ -139,6 +139,9 @@ class MapperNode {
   // LOCKSTEP: the earliest message time of this node's next output (runtime::Node::on_quiet_until).
   int64_t quiet_until(int64_t utime) const;
   void worker_loop();
+  // No tick will come (the simulator ended, or the node stops): drops this node's promise and
+  // publishes every frame in flight now.
+  void flush_without_clock();
   void on_odometry(const semx::odometry_t& m);
   void on_request(const semx::map_request_t& m);
   void publish_snapshot();

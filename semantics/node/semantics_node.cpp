@@ -122,8 +122,7 @@ void SemanticsNode::complete(int64_t frame_id) {
   if (!p.depth || (need_labels_ && !p.labels) || (need_rgb_ && !p.rgb)) return;
   Frame frame = std::move(it->second.frame);
   pending_.erase(it);
-  // Without a clock no tick would ever process it (frames fed by hand): at once, as with latency 0.
-  if (latency_us_ > 0 && node_.clock().started()) {
+  if (deferring()) {
     if (deferred_) process(*deferred_);  // two frames before one tick: the first one now
     deferred_ = std::move(frame);
     return;
@@ -153,7 +152,7 @@ void SemanticsNode::process(const Frame& frame) {
   }
   ++counters_.frames_processed;
   gate_.taken(frame.utime);
-  if (latency_us_ > 0 && node_.clock().started()) {
+  if (deferring()) {
     // Frames closer than the latency (detector.frame_period_s = 0) go out with the first one's.
     if (publish_at_ < 0) publish_at_ = frame.utime + latency_us_;
   } else {

@@ -58,6 +58,9 @@ class SemanticsNode {
   Pending* part(const semx::camera_info_t& info, int64_t utime);
   void complete(int64_t frame_id);
   void process(const Frame& frame);
+  // Frames wait for their tick's ack (detector.latency_s > 0). Without a clock no tick would
+  // ever process them (frames fed by hand): at once, as with latency 0.
+  bool deferring() const { return latency_us_ > 0 && node_.clock().started(); }
   void on_tick(int64_t utime);
   void maybe_publish(int64_t utime);
   void update_state();

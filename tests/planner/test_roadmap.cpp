@@ -478,18 +478,25 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   }
 }
 
+// The 0.6 m doorway with a jamb beside it (the test above), the vehicle south of it, and the
+// first cycle planned; returns that cycle's context.
+PlanContext plan_south_of_doorway(DepFixture& f, DepStrategy& dep) {
+  two_rooms_with_doorway(f.grid, 3.25, 3.85);
+  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);
+  f.frontiers.reset(f.grid);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
+  dep.plan(ctx);
+  return ctx;
+}
+
 TEST(DepRoadmap, RecoveryGivesAPassageNodeOnTheCutItsApproachesAgain) {
   // The doorway of the test above, crossed through its passage node; then the approach node on the
   // far side goes (a map change pruned it). The far node next to the doorway is off the line
   // through its middle, so no edge can join them: recovery puts the approach back, once.
   DepFixture f;
-  two_rooms_with_doorway(f.grid, 3.25, 3.85);
-  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);
-  f.frontiers.reset(f.grid);
   DepStrategy dep(f.config, false);
-  dep.on_map_reset();
-  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
-  dep.plan(ctx);
+  PlanContext ctx = plan_south_of_doorway(f, dep);
   for (const Eigen::Vector3d& q : {Eigen::Vector3d(2.0, 6.0, 1.2), Eigen::Vector3d(5.0, 6.5, 1.2)})
     ASSERT_GE(dep.try_insert(ctx, q), -1);
   const int64_t passage = dep.try_insert(ctx, {3.5, 4.02, 1.15});
@@ -535,13 +542,8 @@ TEST(DepRoadmap, RecoveryPutsAPassageNodeInADoorwayCrowdedByNodesOnBothSides) {
   // within min_node_distance (0.5 m) of both and was always dropped, so the rooms stayed apart
   // (env3, seed 2: DONE at 69 %). While recovering it is kept as a passage node.
   DepFixture f;
-  two_rooms_with_doorway(f.grid, 3.25, 3.85);
-  fill_m(f.grid, {2.95, 4.15, 0.05}, {2.95, 5.05, 2.05}, VoxelState::kOccupied);
-  f.frontiers.reset(f.grid);
   DepStrategy dep(f.config, false);
-  dep.on_map_reset();
-  PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.0, 1);
-  dep.plan(ctx);
+  PlanContext ctx = plan_south_of_doorway(f, dep);
   dep.graph().add_node({3.55, 3.7, 1.15});
   dep.graph().add_node({3.55, 4.35, 1.15});
   EXPECT_EQ(dep.try_insert(ctx, {3.5, 4.02, 1.15}), -1);

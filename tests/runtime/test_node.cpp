@@ -30,6 +30,16 @@ NodeOptions memq(const std::string& name, bool lockstep = false) {
 
 void drain(Node& n) { n.drain(); }
 
+// SIM_CLOCK tick k (10 ms apart) in LOCKSTEP, handled.
+void lockstep_tick(Node& n, int64_t k) {
+  semx::clock_t c{};
+  c.utime = k * 10000;
+  c.tick = k;
+  c.mode = semx::clock_t::LOCKSTEP;
+  n.publish("SIM_CLOCK", c);
+  drain(n);
+}
+
 semx::odometry_t odom(double x) {
   semx::odometry_t m{};
   m.utime = 1;
@@ -171,14 +181,7 @@ TEST(Node, LockstepNodeDoesTickWorkThenAcks) {
     order.push_back("ack" + std::to_string(a.tick));
   });
   n.subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t&) { order.push_back("out"); });
-  for (int64_t tick : {0, 1, 1, 2}) {
-    semx::clock_t c{};
-    c.utime = tick * 10000;
-    c.tick = tick;
-    c.mode = semx::clock_t::LOCKSTEP;
-    n.publish("SIM_CLOCK", c);
-    drain(n);
-  }
+  for (int64_t tick : {0, 1, 1, 2}) lockstep_tick(n, tick);
   EXPECT_EQ(order, (std::vector<std::string>{"work0", "out", "ack0", "work1", "out", "ack1", "ack1", "work2",
                                              "out", "ack2"}));
   EXPECT_EQ(n.now_utime(), 20000);
@@ -198,14 +201,7 @@ TEST(Node, WithinItsPromiseANodeAcksOnlyEvery50msAndRunsDeferredWorkAfterTheAck)
   });
   n.subscribe<semx::ack_t>("SIM_ACK",
                            [&](const semx::ack_t& a) { order.push_back("ack" + std::to_string(a.tick)); });
-  auto tick = [&](int64_t k) {
-    semx::clock_t c{};
-    c.utime = k * 10000;
-    c.tick = k;
-    c.mode = semx::clock_t::LOCKSTEP;
-    n.publish("SIM_CLOCK", c);
-    drain(n);
-  };
+  auto tick = [&](int64_t k) { lockstep_tick(n, k); };
   tick(0);
   tick(1);
   promise = 250000;  // quiet until 0.25 s, said with the ack of tick 2

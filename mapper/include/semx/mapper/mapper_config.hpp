@@ -72,7 +72,7 @@ struct StreamingParams {
   // first tick at least this long after the frame (message time, so every run publishes them at
   // the same tick). 0 = in the frame's handler, before the ack of the frame's own tick. 0.09 s:
   // the integration overlaps the other nodes' next 9 ticks, within the clock's 0.1 s max_slack
-  // (env3's first 120 s: 26.0 s of wall time against 27.0 s with 0.04 s; docs/runtime.md).
+  // (env3's first 120 s: 25.4 s of wall time against 27.5 s with 0.04 s; docs/runtime.md).
   double lockstep_delay = 0.09;
 };
 
