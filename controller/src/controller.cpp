@@ -158,7 +158,7 @@ StepOutput Controller::step(int64_t now) {
     if (esdf_new_ && trajectory_ && status_.state == ControllerState::kTracking) {
       const double t = trajectory_->time_at(now);
       const ClearanceReport c = check_clearance(*trajectory_, *esdf_, t, t + config_.safety.check_horizon,
-                                                generator_.flight_rule());
+                                                generator_.flight_rule(trajectory_->optimized));
       if (!c.ok) {
         ++counters_.brakes;
         stop(ControllerState::kBraking, "predicted collision in " + fmt(c.violation_time - t) +

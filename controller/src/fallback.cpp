@@ -41,28 +41,66 @@ std::vector<double> trapezoid_steps(double length, double cruise, double ramp) {
 
 }  // namespace
 
-FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points, double max_speed,
+FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
+                                    const Eigen::Vector3d& start_velocity, double max_speed,
                                     double max_acceleration, double knot_interval) {
   const double dt = knot_interval;
   const double cruise = max_speed * dt, ramp = max_acceleration * dt * dt;
   FallbackSpline out;
   PositionSpline::Points q;
   out.point_times.push_back(0.0);
-  for (int k = 0; k < 3; ++k) q.push_back(points.front());
-  for (std::size_t i = 1; i < points.size(); ++i) {
-    const Eigen::Vector3d a = points[i - 1], d = points[i] - points[i - 1];
+  const Eigen::Vector3d start = points.front();
+  // The vehicle cannot stop at once: a reference at rest while it moves is flown off by the
+  // braking distance (0.2 m at 0.9 m/s), off the path the planner checked. So the curve first
+  // brakes along the velocity at the limit, like the vehicle will, then returns to the path.
+  Eigen::Vector3d at = start;
+  const bool moving = start_velocity.allFinite() && start_velocity.norm() * dt > 1e-6;
+  if (moving) {
+    // p(0) = Q1, v(0) = (Q2 - Q0)/2dt, a(0) = 0, as the optimised curve starts.
+    const Eigen::Vector3d u = start_velocity.normalized();
+    q.push_back(start - dt * start_velocity);
+    q.push_back(start);
+    at = start + dt * start_velocity;
+    q.push_back(at);
+    for (double step = start_velocity.norm() * dt - ramp; step > 0; step -= ramp) {
+      at += step * u;
+      q.push_back(at);
+    }
+    for (int k = 0; k < 2; ++k) q.push_back(at);
+  } else {
+    for (int k = 0; k < 3; ++k) q.push_back(start);
+  }
+  // Straight on from `from` to `to`, stopping there (three equal control points).
+  const auto leg = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    const Eigen::Vector3d d = to - from;
     const double length = d.norm();
     const std::vector<double> steps = trapezoid_steps(length, cruise, ramp);
     double s = 0;
     for (std::size_t k = 0; k + 1 < steps.size(); ++k) {
       s += steps[k];
-      q.push_back(a + d * (s / length));
+      q.push_back(from + d * (s / length));
     }
-    // The curve reaches a triple's point at the knot of its first copy.
-    out.point_times.push_back(static_cast<double>(q.size()) * dt);
-    for (int k = 0; k < 3; ++k) q.push_back(points[i]);
+    for (int k = 0; k < 3; ++k) q.push_back(to);
+  };
+  constexpr double kSame = 1e-6;  // m
+  if (moving) {
+    // Back onto the first segment at its point nearest the stop: the braking ray and this leg are
+    // the only parts off the path, and the clearance check covers both.
+    Eigen::Vector3d back = start;
+    if (points.size() > 1) {
+      const Eigen::Vector3d d = points[1] - start;
+      back = start + d * std::clamp((at - start).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    }
+    if ((back - at).norm() > kSame) leg(at, back);
+    at = back;
   }
-  while (q.size() < 4) q.push_back(points.back());  // a lone point: hover
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    if ((points[i] - at).norm() > kSame) leg(at, points[i]);
+    // The curve reaches a triple's point at the knot of its first copy.
+    out.point_times.push_back(static_cast<double>(q.size() - 3) * dt);
+    at = points[i];
+  }
+  while (q.size() < 4) q.push_back(points.back());  // a lone point at rest: hover
   out.spline = PositionSpline(std::move(q), dt);
   return out;
 }

@@ -42,10 +42,11 @@ ClearanceRule TrajectoryGenerator::generation_rule(bool optimised) const {
   return r;
 }
 
-ClearanceRule TrajectoryGenerator::flight_rule() const {
-  ClearanceRule r = generation_rule(false);
+ClearanceRule TrajectoryGenerator::flight_rule(bool optimised) const {
+  ClearanceRule r = generation_rule(optimised);
   r.bound = config_.clearance.brake_bound();
-  r.require_exit = false;  // a horizon may end before an escape does
+  r.footprint_margin = 0.0;  // brake only when the body itself would touch, not on map jitter
+  r.require_exit = false;    // a horizon may end before an escape does
   return r;
 }
 
@@ -67,12 +68,17 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   return result.clearance.ok;
 }
 
+Eigen::Vector3d TrajectoryGenerator::start_velocity(const StartState& start, double v_max) {
+  Eigen::Vector3d v0 = start.velocity.allFinite() ? start.velocity : Eigen::Vector3d::Zero();
+  if (v0.norm() > v_max) v0 *= v_max / v0.norm();
+  return v0;
+}
+
 PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vector3d>& polyline,
                                                    const StartState& start, double v_max,
                                                    std::vector<double>* point_times) const {
   const double dt = config_.trajectory.knot_interval;
-  Eigen::Vector3d v0 = start.velocity.allFinite() ? start.velocity : Eigen::Vector3d::Zero();
-  if (v0.norm() > v_max) v0 *= v_max / v0.norm();
+  const Eigen::Vector3d v0 = start_velocity(start, v_max);
   const double along = polyline.size() > 1 ? v0.dot((polyline[1] - polyline[0]).normalized()) : 0.0;
   const TimedPolyline timed(polyline, along, v_max, config_.limits.max_acceleration, dt);
   if (point_times) *point_times = timed.point_times();
@@ -156,17 +162,23 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
     result.cause = FallbackCause::kOptimizerOff;
   }
 
+  // The fallback brakes from the vehicle's velocity first, as the vehicle will. Where that ray
+  // is too close to an obstacle, the fallback at rest on the path is still the best reference:
+  // the tracker then brakes as hard as the vehicle can, and no reference can stop it sooner.
   const double v_fallback = v_max * config_.trajectory.fallback_speed_factor;
-  FallbackSpline fb = make_fallback_spline(polyline, v_fallback, a_max, dt);
-  Trajectory safe;
-  safe.optimized = false;
-  safe.position = std::move(fb.spline);
-  if (finish(safe, fb.point_times, yaws, v_max, field, result)) {
+  const auto fallback = [&](const Eigen::Vector3d& v) {
+    FallbackSpline fb = make_fallback_spline(polyline, v, v_fallback, a_max, dt);
+    Trajectory safe;
+    safe.optimized = false;
+    safe.position = std::move(fb.spline);
+    if (!finish(safe, fb.point_times, yaws, v_max, field, result)) return false;
     result.ok = true;
     result.trajectory = std::move(safe);
     result.reason = "fallback: " + why;
-    return result;
-  }
+    return true;
+  };
+  const Eigen::Vector3d v0 = start_velocity(start, v_max);
+  if (fallback(v0) || (!v0.isZero() && fallback(Eigen::Vector3d::Zero()))) return result;
   result.reason = "no safe trajectory: " + why + "; the path itself: " + describe(result.clearance);
   return result;
 }

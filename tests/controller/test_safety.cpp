@@ -165,6 +165,40 @@ TEST(Safety, IgnoresObstaclesBeyondTheHorizonAndOffThePath) {
   EXPECT_GT(loop.field->distance(loop.vehicle.position), cfg.clearance.half_size);
 }
 
+TEST(Safety, BrakesWhenANewMapPutsAWallsEndWithinTheTurnedBodysReach) {
+  // An optimised trajectory's far part lay outside the mapper's window (free) when it was made;
+  // on arrival its turned body's corner met a jamb's end that the plain bound let pass (env3, 50
+  // samples, seed 3, t = 141.7 s). Heading 45° off the way, 0.33 m beside a post: above the
+  // 0.30 m brake bound, within the corner's 0.354 m.
+  ControllerConfig cfg;
+  Loop loop(cfg, std::make_shared<FreeField>());
+  loop.vehicle.position = Eigen::Vector3d(0, 0, 1);
+  loop.vehicle.yaw = M_PI / 4;
+  loop.run(0.1);
+  loop.send_path({{0, 0, 1}, {10, 0, 1}}, {M_PI / 4, M_PI / 4}, 3);
+  loop.run(2.0);
+  ASSERT_EQ(loop.controller.status().state, ControllerState::kTracking);
+  ASSERT_TRUE(loop.controller.trajectory()->optimized);
+  const double x = loop.vehicle.position.x();
+  const auto post = std::make_shared<PostField>(Eigen::Vector2d(x + 1.2, 0.33));
+  loop.field = post;
+  loop.run_until([&] { return loop.controller.status().state != ControllerState::kTracking; }, 0.05);
+  EXPECT_EQ(loop.controller.status().state, ControllerState::kBraking);
+  EXPECT_EQ(loop.controller.counters().brakes, 1);
+  loop.run(3.0);
+  EXPECT_LT(loop.vehicle.position.x(), x + 1.2);
+  // Faced square to the post, the same trajectory flies on past it.
+  Loop square(cfg, std::make_shared<FreeField>());
+  square.vehicle.position = Eigen::Vector3d(0, 0, 1);
+  square.run(0.1);
+  square.send_path({{0, 0, 1}, {10, 0, 1}}, {0, 0}, 3);
+  square.run(2.0);
+  square.field = std::make_shared<PostField>(Eigen::Vector2d(square.vehicle.position.x() + 1.2, 0.33));
+  square.run(3.0);
+  EXPECT_EQ(square.controller.counters().brakes, 0);
+  EXPECT_GT(square.vehicle.position.x(), x + 1.5);
+}
+
 TEST(Safety, StaleOdometryStopsTheVehicle) {
   ControllerConfig cfg;
   Loop loop(cfg, boxes_field({}));

@@ -67,6 +67,29 @@ TEST(Tracking, ConvergesFromAnOffsetStartOnAPointMass) {
   EXPECT_LT(loop.vehicle.velocity.norm(), 0.02);
 }
 
+TEST(Tracking, AFallbackTakenWhileMovingIsFlownAsPlanned) {
+  // A fallback that started at rest while the vehicle descended at 0.9 m/s was flown 0.17 m
+  // below its reference while the vehicle braked, and the body's corner hit a shelf's top edge
+  // (env1, 30 samples, seed 2, t = 77.4 s). Braking in the reference keeps the error small.
+  ControllerConfig cfg;
+  cfg.optimizer.max_iterations = 0;  // every path flies the fallback
+  Loop loop(cfg, std::make_shared<FreeField>());
+  loop.vehicle.position = Eigen::Vector3d(0, 0, 1.5);
+  loop.vehicle.velocity = Eigen::Vector3d(0, 0, -0.9);
+  loop.vehicle.holding = false;
+  loop.run(0.02);
+  loop.send_path({loop.vehicle.position, {0.4, -0.45, 1.9}, {1.4, -1.0, 2.0}}, {0, 0, 0}, 1);
+  loop.step();
+  ASSERT_EQ(loop.controller.status().state, ControllerState::kTracking) << loop.controller.status().reason;
+  double worst = 0;
+  while (loop.controller.status().state == ControllerState::kTracking) {
+    loop.step();
+    worst = std::max(worst, loop.last.status.tracking_error);
+  }
+  EXPECT_EQ(loop.controller.status().state, ControllerState::kHolding);
+  EXPECT_LT(worst, 0.06);
+}
+
 TEST(Tracking, ErrorDecaysAfterADisturbance) {
   ControllerConfig cfg;
   Loop loop(cfg, std::make_shared<FreeField>());

@@ -303,7 +303,7 @@ TEST(TrajectoryGeneration, AVehicleTooCloseToAWallMayOnlyEscape) {
 
 TEST(Fallback, StopsAtEveryWaypointWithinTheLimits) {
   const std::vector<Eigen::Vector3d> pts{{0, 0, 0}, {1, 0, 0}, {1, 0.05, 0}, {3, 2, 1}};
-  const FallbackSpline fb = make_fallback_spline(pts, 0.5, 2.0, 0.25);
+  const FallbackSpline fb = make_fallback_spline(pts, Eigen::Vector3d::Zero(), 0.5, 2.0, 0.25);
   ASSERT_EQ(fb.point_times.size(), pts.size());
   Trajectory t;
   t.position = fb.spline;
@@ -315,6 +315,39 @@ TEST(Fallback, StopsAtEveryWaypointWithinTheLimits) {
   const Extremes e = sample_all(t);
   EXPECT_LE(e.speed, 0.5 * (1 + 1e-9));
   EXPECT_LE(e.acceleration, 2.0 * (1 + 1e-9));
+}
+
+TEST(Fallback, AMovingStartBrakesAlongItsVelocityThenReturnsToThePath) {
+  // Descending at 0.9 m/s when a path up and sideways comes: the curve cannot start at rest.
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1.5}, {1, -1, 2}, {2, -1, 2}};
+  const Eigen::Vector3d v0(0, 0, -0.9);
+  const double a = 2.0;
+  const FallbackSpline fb = make_fallback_spline(pts, v0, 0.5, a, 0.25);
+  ASSERT_EQ(fb.point_times.size(), pts.size());
+  Trajectory t;
+  t.position = fb.spline;
+  const TrajectoryPoint p0 = t.sample(0.0);
+  EXPECT_LT((p0.position - pts[0]).norm(), 1e-12);
+  EXPECT_LT((p0.velocity - v0).norm(), 1e-12);
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const TrajectoryPoint p = t.sample(fb.point_times[i]);
+    EXPECT_LT((p.position - pts[i]).norm(), 1e-12) << i;
+    EXPECT_LT(p.velocity.norm(), 1e-12) << i;
+  }
+  const Extremes e = sample_all(t);
+  EXPECT_LE(e.speed, 0.9 * (1 + 1e-9));
+  EXPECT_LE(e.acceleration, a * (1 + 1e-9));
+  // It goes as low as braking at the limit takes (0.9² / 2a = 0.2 m, plus at most one knot's
+  // worth of the discrete ramp), straight below the start, and is otherwise on that ray or the path.
+  double lowest = 1e300;
+  for (double s = 0; s <= t.duration(); s += kSampleDt) {
+    const Eigen::Vector3d p = t.position_at(s);
+    lowest = std::min(lowest, p.z());
+    const double off_ray = Eigen::Vector2d(p.x(), p.y()).norm();
+    ASSERT_LT(std::min(off_ray, distance_to_polyline(pts, p)), 1e-9) << "off the ray and the path at " << s;
+  }
+  EXPECT_LT(lowest, 1.5 - 0.9 * 0.9 / (2 * a) + 1e-9);
+  EXPECT_GT(lowest, 1.5 - 0.9 * 0.9 / (2 * a) - 0.9 * 0.25);
 }
 
 TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback) {
@@ -346,14 +379,17 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback
 
 TEST(TrajectoryGeneration, OnlyOptimisedCurvesAnswerForTheTurnedBody) {
   // The fallback is the planner's own path (in a doorway, 0.35 m from the jambs in the ESDF, where
-  // a body heading diagonally still fits the world): it and the brake check keep the plain bounds.
+  // a body heading diagonally still fits the world): it keeps the plain bounds, and so does the
+  // brake check while it is flown. An optimised curve is braked when its body would touch.
   ControllerConfig cfg;
   const TrajectoryGenerator gen(cfg);
   EXPECT_EQ(gen.generation_rule(true).footprint_half_xy, cfg.clearance.half_size);
   EXPECT_EQ(gen.generation_rule(true).footprint_half_z, cfg.clearance.half_height);
   EXPECT_EQ(gen.generation_rule(true).footprint_margin, cfg.clearance.footprint_margin);
   EXPECT_EQ(gen.generation_rule(false).footprint_half_xy, 0.0);
-  EXPECT_EQ(gen.flight_rule().footprint_half_xy, 0.0);
+  EXPECT_EQ(gen.flight_rule(false).footprint_half_xy, 0.0);
+  EXPECT_EQ(gen.flight_rule(true).footprint_half_xy, cfg.clearance.half_size);
+  EXPECT_EQ(gen.flight_rule(true).footprint_margin, 0.0);
   cfg.clearance.turned_body = false;
   EXPECT_EQ(TrajectoryGenerator(cfg).generation_rule(true).footprint_half_xy, 0.0);
 

@@ -3,6 +3,10 @@
 // any four consecutive control points are collinear and the curve cannot cut a corner: it is
 // as collision-free as the planner's path. Along each segment the control points follow a
 // discrete trapezoid, so speed and acceleration stay within the limits given.
+//
+// A vehicle that moves when the fallback starts cannot be on the path at rest: the curve starts
+// with its velocity, brakes straight along it at `max_acceleration`, and returns to the first
+// segment at its point nearest the stop. Only that ray and that return leave the polyline.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,8 +21,10 @@ struct FallbackSpline {
   std::vector<double> point_times;  // when each polyline point is reached, s
 };
 
-// `points` must have no repeats; a single point gives a hover there.
-FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points, double max_speed,
+// `points` must have no repeats; points[0] is where the vehicle is, moving at `start_velocity`;
+// a single point gives a hover there.
+FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
+                                    const Eigen::Vector3d& start_velocity, double max_speed,
                                     double max_acceleration, double knot_interval);
 
 }  // namespace semx::controller

@@ -58,8 +58,11 @@ class TrajectoryGenerator {
   // whose clearance is the planner's to keep: in a doorway its centre line is 0.35 m from the
   // jambs in the ESDF (0.45 m in the world), below the reach of a body heading diagonally.
   ClearanceRule generation_rule(bool optimised = true) const;
-  // The rule a flown trajectory is held to on each new ESDF (bound = half_size + brake_margin).
-  ClearanceRule flight_rule() const;
+  // The rule a flown trajectory is held to on each new ESDF (bound = half_size + brake_margin):
+  // an optimised one also the turned body's reach, with no margin. Its far part may have been
+  // outside the mapper's window (free) when it was generated, so the turned body is checked
+  // there for the first time now.
+  ClearanceRule flight_rule(bool optimised = false) const;
 
   // The farthest the curve gets from the polyline (sampled every kDeviationStep of its time).
   static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline);
@@ -77,6 +80,8 @@ class TrajectoryGenerator {
                                 double v_max, std::vector<double>* point_times = nullptr) const;
 
  private:
+  // The vehicle's velocity (zero when not finite), no faster than v_max: where both curves start.
+  static Eigen::Vector3d start_velocity(const StartState& start, double v_max);
   bool finish(Trajectory& trajectory, const std::vector<double>& times, const std::vector<double>& yaws,
               double v_max, const DistanceField& field, GenerationResult& result) const;
 
