@@ -122,6 +122,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   trajectory_->start_utime = now;
   ++counters_.trajectories;
   ++(trajectory_->optimized ? counters_.optimized : counters_.fallbacks);
+  if (last_generation_.slowed) ++counters_.slowed;
   if (!trajectory_->optimized) {
     switch (last_generation_.cause) {
       case FallbackCause::kStrays:
@@ -138,7 +139,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   error_count_ = 0;
   status_.plan_id = path.plan_id;
   status_.state = ControllerState::kTracking;
-  status_.reason = trajectory_->optimized ? "optimised trajectory" : last_generation_.reason;
+  status_.reason = trajectory_->optimized && !last_generation_.slowed ? "optimised trajectory" : last_generation_.reason;
   out.new_trajectory = &*trajectory_;
 }
 

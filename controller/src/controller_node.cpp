@@ -65,7 +65,7 @@ int ControllerNode::run() {
   const int code = node_.run();
   const ControllerCounters& c = controller_.counters();
   std::cout << "semx-controller: paths " << c.paths << ", trajectories " << c.trajectories << " (optimised "
-            << c.optimized << ", fallback " << c.fallbacks << ": strayed " << c.fallback_strays
+            << c.optimized << " (slowed " << c.slowed << "), fallback " << c.fallbacks << ": strayed " << c.fallback_strays
             << ", too close " << c.fallback_too_close << "), rejected " << c.rejected << ", unsafe "
             << c.unsafe << ", brakes " << c.brakes << ", stale stops " << c.stale_stops << std::endl;
   return code;

@@ -39,7 +39,55 @@ std::vector<double> trapezoid_steps(double length, double cruise, double ramp) {
   return steps;
 }
 
+// The first control points of a curve starting at `start` with velocity v and braking straight
+// along it at the limit (p(0) = Q1, v(0) = (Q2 - Q0)/2dt, a(0) = 0, as the optimised curve
+// starts); the last is where it stops. Empty when v is (about) zero.
+PositionSpline::Points braking_points(const Eigen::Vector3d& start, const Eigen::Vector3d& v, double ramp,
+                                      double dt) {
+  PositionSpline::Points q;
+  if (!v.allFinite() || v.norm() * dt <= 1e-6) return q;
+  const Eigen::Vector3d u = v.normalized();
+  q.push_back(start - dt * v);
+  q.push_back(start);
+  Eigen::Vector3d at = start + dt * v;
+  q.push_back(at);
+  for (double step = v.norm() * dt - ramp; step > 0; step -= ramp) {
+    at += step * u;
+    q.push_back(at);
+  }
+  return q;
+}
+
+// Where the fallback returns to the path after braking to `stop`: the first segment's point
+// nearest the stop.
+Eigen::Vector3d return_point(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& stop) {
+  const Eigen::Vector3d start = points.front();
+  if (points.size() < 2) return start;
+  const Eigen::Vector3d d = points[1] - start;
+  return start + d * std::clamp((stop - start).dot(d) / d.squaredNorm(), 0.0, 1.0);
+}
+
+constexpr double kSame = 1e-6;  // m
+
 }  // namespace
+
+std::vector<Eigen::Vector3d> fallback_route(const std::vector<Eigen::Vector3d>& points,
+                                            const Eigen::Vector3d& start_velocity, double max_acceleration,
+                                            double knot_interval) {
+  const double dt = knot_interval;
+  const PositionSpline::Points brake =
+      braking_points(points.front(), start_velocity, max_acceleration * dt * dt, dt);
+  std::vector<Eigen::Vector3d> route{points.front()};
+  const auto add = [&](const Eigen::Vector3d& p) {
+    if ((p - route.back()).norm() > kSame) route.push_back(p);
+  };
+  if (!brake.empty()) {
+    add(brake.back());
+    add(return_point(points, brake.back()));
+  }
+  for (std::size_t i = 1; i < points.size(); ++i) add(points[i]);
+  return route;
+}
 
 FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
                                     const Eigen::Vector3d& start_velocity, double max_speed,
@@ -47,29 +95,16 @@ FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
   const double dt = knot_interval;
   const double cruise = max_speed * dt, ramp = max_acceleration * dt * dt;
   FallbackSpline out;
-  PositionSpline::Points q;
   out.point_times.push_back(0.0);
   const Eigen::Vector3d start = points.front();
   // The vehicle cannot stop at once: a reference at rest while it moves is flown off by the
   // braking distance (0.2 m at 0.9 m/s), off the path the planner checked. So the curve first
   // brakes along the velocity at the limit, like the vehicle will, then returns to the path.
-  Eigen::Vector3d at = start;
-  const bool moving = start_velocity.allFinite() && start_velocity.norm() * dt > 1e-6;
-  if (moving) {
-    // p(0) = Q1, v(0) = (Q2 - Q0)/2dt, a(0) = 0, as the optimised curve starts.
-    const Eigen::Vector3d u = start_velocity.normalized();
-    q.push_back(start - dt * start_velocity);
-    q.push_back(start);
-    at = start + dt * start_velocity;
-    q.push_back(at);
-    for (double step = start_velocity.norm() * dt - ramp; step > 0; step -= ramp) {
-      at += step * u;
-      q.push_back(at);
-    }
-    for (int k = 0; k < 2; ++k) q.push_back(at);
-  } else {
-    for (int k = 0; k < 3; ++k) q.push_back(start);
-  }
+  PositionSpline::Points q = braking_points(start, start_velocity, ramp, dt);
+  const bool moving = !q.empty();
+  if (!moving) q.push_back(start);
+  for (int k = 0; k < 2; ++k) q.push_back(q.back());
+  Eigen::Vector3d at = q.back();
   // Straight on from `from` to `to`, stopping there (three equal control points).
   const auto leg = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
     const Eigen::Vector3d d = to - from;
@@ -82,15 +117,9 @@ FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
     }
     for (int k = 0; k < 3; ++k) q.push_back(to);
   };
-  constexpr double kSame = 1e-6;  // m
   if (moving) {
-    // Back onto the first segment at its point nearest the stop: the braking ray and this leg are
-    // the only parts off the path, and the clearance check covers both.
-    Eigen::Vector3d back = start;
-    if (points.size() > 1) {
-      const Eigen::Vector3d d = points[1] - start;
-      back = start + d * std::clamp((at - start).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    }
+    // The braking ray and this leg are the only parts off the path; the clearance check covers both.
+    const Eigen::Vector3d back = return_point(points, at);
     if ((back - at).norm() > kSame) leg(at, back);
     at = back;
   }

@@ -76,9 +76,9 @@ Eigen::Vector3d TrajectoryGenerator::start_velocity(const StartState& start, dou
 
 PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vector3d>& polyline,
                                                    const StartState& start, double v_max,
-                                                   std::vector<double>* point_times) const {
+                                                   std::vector<double>* point_times, double v_start) const {
   const double dt = config_.trajectory.knot_interval;
-  const Eigen::Vector3d v0 = start_velocity(start, v_max);
+  const Eigen::Vector3d v0 = start_velocity(start, std::max(v_max, v_start));
   const double along = polyline.size() > 1 ? v0.dot((polyline[1] - polyline[0]).normalized()) : 0.0;
   const TimedPolyline timed(polyline, along, v_max, config_.limits.max_acceleration, dt);
   if (point_times) *point_times = timed.point_times();
@@ -134,28 +134,48 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
 
   std::string why;
   if (config_.optimizer.max_iterations > 0) {
-    std::vector<double> times;
-    Trajectory smooth;
-    smooth.optimized = true;
-    smooth.position = initial_spline(polyline, start, v_max, &times);
-    result.optimizer = optimizer_.optimize(smooth.position, field, v_max, a_max,
-                                           config_.clearance.bound() + config_.optimizer.target_margin);
-    if (result.optimizer.failed) {
-      why = "optimiser failed (" + result.optimizer.message + ")";
-      result.cause = FallbackCause::kOptimizerFailed;
-    } else if (const double off = deviation(smooth.position, polyline);
-               off > config_.trajectory.max_deviation) {
-      std::ostringstream s;
-      s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
-      why = s.str();
-      result.cause = FallbackCause::kStrays;
-    } else if (finish(smooth, times, yaws, v_max, field, result)) {
-      result.ok = true;
-      result.trajectory = std::move(smooth);
-      return result;
-    } else {
-      why = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
-      result.cause = FallbackCause::kTooClose;
+    // A curve that strays or comes too close at full speed is tried once more at the fallback's
+    // cruise speed: a corner is cut by about v²/a, so a quarter as far at half the speed, and the
+    // curve still does not stop at every waypoint as the fallback does.
+    const double slow = v_max * config_.trajectory.fallback_speed_factor;
+    for (const double cruise : {v_max, slow}) {
+      if (cruise != v_max && (!(slow < v_max) || result.cause == FallbackCause::kOptimizerFailed)) break;
+      std::vector<double> times;
+      Trajectory smooth;
+      smooth.optimized = true;
+      smooth.position = initial_spline(polyline, start, cruise, &times, v_max);
+      result.optimizer = optimizer_.optimize(smooth.position, field, v_max, a_max,
+                                             config_.clearance.bound() + config_.optimizer.target_margin);
+      std::string attempt;
+      FallbackCause cause = FallbackCause::kNone;
+      if (result.optimizer.failed) {
+        attempt = "optimiser failed (" + result.optimizer.message + ")";
+        cause = FallbackCause::kOptimizerFailed;
+      } else if (const double off = deviation(
+                     smooth.position, fallback_route(polyline, start_velocity(start, v_max), a_max, dt));
+                 off > config_.trajectory.max_deviation) {
+        std::ostringstream s;
+        s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
+        attempt = s.str();
+        cause = FallbackCause::kStrays;
+      } else if (finish(smooth, times, yaws, v_max, field, result)) {
+        result.ok = true;
+        result.slowed = cruise != v_max;
+        result.trajectory = std::move(smooth);
+        if (result.slowed) {
+          std::ostringstream s;
+          s << "optimised at " << std::setprecision(3) << cruise << " m/s: " << why;
+          result.reason = s.str();
+        }
+        return result;
+      } else {
+        attempt = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
+        cause = FallbackCause::kTooClose;
+      }
+      if (cruise == v_max) {  // the full-speed attempt says why the vehicle does not fly it
+        why = attempt;
+        result.cause = cause;
+      }
     }
   } else {
     why = "optimiser disabled";

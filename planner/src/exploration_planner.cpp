@@ -97,17 +97,25 @@ void ExplorationPlanner::on_controller_status(ControllerState state, int64_t pla
   }
 }
 
-bool ExplorationPlanner::goal_reached(int64_t utime) {
-  if (!goal_.valid || !pose_) return false;
+void ExplorationPlanner::track_arrival(int64_t utime) {
   const bool within =
-      (pose_->position - goal_.position).norm() <= config_.loop.goal_tolerance &&
+      goal_.valid && pose_ && (pose_->position - goal_.position).norm() <= config_.loop.goal_tolerance &&
       (controller_holding_ || yaw_distance(pose_->yaw, goal_.yaw) <= config_.loop.yaw_tolerance);
   if (!within) {
     arrived_utime_ = -1;
-    return false;
+  } else if (arrived_utime_ < 0) {
+    arrived_utime_ = utime;
   }
-  if (arrived_utime_ < 0) arrived_utime_ = utime;
-  return utime - arrived_utime_ >= static_cast<int64_t>(std::llround(config_.loop.dwell_s * 1e6));
+}
+
+int64_t ExplorationPlanner::reached_utime(int64_t utime) const {
+  return (arrived_utime_ >= 0 ? arrived_utime_ : utime) +
+         static_cast<int64_t>(std::llround(config_.loop.dwell_s * 1e6));
+}
+
+bool ExplorationPlanner::goal_reached(int64_t utime) {
+  track_arrival(utime);
+  return arrived_utime_ >= 0 && utime >= reached_utime(utime);
 }
 
 bool ExplorationPlanner::held_short(int64_t utime) {
@@ -204,6 +212,9 @@ int64_t ExplorationPlanner::min_charge_us() const {
 ExplorationPlanner::Output ExplorationPlanner::poll(int64_t utime, bool& cycle_due) {
   Output out;
   cycle_due = false;
+  // Arrival is watched on every tick, and a goal reached starts a cycle at once, not at the next
+  // 1/rate_hz slot: at 4 Hz a vehicle waited 0.74 s at each goal instead of the dwell's 0.3 s.
+  track_arrival(utime);
   if (pending_.active) {
     if (utime >= pending_.ready_utime) release(out, utime);
     return out;
@@ -218,7 +229,8 @@ ExplorationPlanner::Output ExplorationPlanner::poll(int64_t utime, bool& cycle_d
     }
     return out;
   }
-  cycle_due = next_cycle_utime_ < 0 || utime >= next_cycle_utime_;
+  cycle_due = next_cycle_utime_ < 0 || utime >= next_cycle_utime_ ||
+              (arrived_utime_ >= 0 && utime >= reached_utime(utime));
   return out;
 }
 
@@ -226,7 +238,8 @@ int64_t ExplorationPlanner::quiet_until(int64_t utime) const {
   if (pending_.active) return pending_.ready_utime;
   if (state_ == PlannerState::kDone) return std::numeric_limits<int64_t>::max();
   if (!grid_ || !pose_ || next_cycle_utime_ < 0) return utime;
-  return next_cycle_utime_;
+  // A goal may be reached before the next slot (arrival counts from the next tick at the earliest).
+  return goal_.valid ? std::min(next_cycle_utime_, reached_utime(utime)) : next_cycle_utime_;
 }
 
 void ExplorationPlanner::run_cycle(int64_t utime) {

@@ -350,7 +350,7 @@ TEST(Fallback, AMovingStartBrakesAlongItsVelocityThenReturnsToThePath) {
   EXPECT_GT(lowest, 1.5 - 0.9 * 0.9 / (2 * a) - 0.9 * 0.25);
 }
 
-TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback) {
+TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysIsSlowedThenTakesTheFallback) {
   // deviation(): a curve on a line 0.3 m beside a straight path is 0.3 m from it.
   PositionSpline::Points q;
   for (int i = 0; i < 8; ++i) q.push_back(Eigen::Vector3d(0.5 * i, 0.3, 1.0));
@@ -367,14 +367,28 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysFromThePathTakesTheFallback
   const double cut = TrajectoryGenerator::deviation(smooth.trajectory.position, corner);
   EXPECT_GT(cut, 0.0);
   EXPECT_LE(cut, cfg.trajectory.max_deviation);
-  // ... but not within a corridor narrower than its cut: then the fallback, on the path itself.
+  // ... not within a corridor narrower than that cut: then it is optimised again at the
+  // fallback's cruise speed, cutting the corner far less...
   cfg.trajectory.max_deviation = 0.5 * cut;
+  const GenerationResult slowed =
+      TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]), 0.0, FreeField());
+  ASSERT_TRUE(slowed.ok) << slowed.reason;
+  EXPECT_TRUE(slowed.trajectory.optimized);
+  EXPECT_TRUE(slowed.slowed);
+  EXPECT_NE(slowed.reason.find("strays"), std::string::npos) << slowed.reason;
+  const double slow_cut = TrajectoryGenerator::deviation(slowed.trajectory.position, corner);
+  EXPECT_GT(slow_cut, 0.0);
+  EXPECT_LE(slow_cut, 0.5 * cut);
+  // ... and within one narrower still, the fallback, on the path itself.
+  cfg.trajectory.max_deviation = 0.5 * slow_cut;
   const GenerationResult strict =
       TrajectoryGenerator(cfg).generate(corner, {0, 0, M_PI / 2}, at_rest(corner[0]), 0.0, FreeField());
   ASSERT_TRUE(strict.ok) << strict.reason;
   EXPECT_FALSE(strict.trajectory.optimized);
+  EXPECT_FALSE(strict.slowed);
   EXPECT_NE(strict.reason.find("strays"), std::string::npos) << strict.reason;
   EXPECT_LT(TrajectoryGenerator::deviation(strict.trajectory.position, corner), 1e-6);
+  EXPECT_LT(slowed.trajectory.duration(), strict.trajectory.duration()) << "the slowed curve does not stop";
 }
 
 TEST(TrajectoryGeneration, OnlyOptimisedCurvesAnswerForTheTurnedBody) {

@@ -299,6 +299,30 @@ TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
   EXPECT_NE(p.goal().node, unreachable.node);
 }
 
+TEST(Planner, AGoalReachedStartsACycleOnceTheDwellIsOverNotAtTheNextSlot) {
+  // Cycles at 4 Hz, planning free (each cycle's outputs go out on its own tick).
+  PlannerConfig c = test_config();
+  c.charge.scale = 0.0;
+  ExplorationPlanner p(c);
+  mapper::StateGrid g = corridor();
+  p.set_map(&g);
+  p.set_pose(pose({1, 2, 1.2}));
+  int64_t t = 0;
+  const auto first = first_path(p, 0, 2000000, &t);
+  ASSERT_TRUE(first);
+  const Goal goal = p.goal();
+  // The vehicle arrives 10 ms after the path, between two slots (t + k · 250 ms).
+  const int64_t arrived = t + 10000;
+  p.set_pose(pose(goal.position, goal.yaw, arrived));
+  const int64_t dwell = static_cast<int64_t>(c.loop.dwell_s * 1e6);
+  EXPECT_LE(p.quiet_until(arrived), arrived + dwell) << "the promise leaves room for the arrival";
+  int64_t when = 0;
+  const auto second = first_path(p, arrived, arrived + 2000000, &when);
+  ASSERT_TRUE(second);
+  EXPECT_NE(p.last_status().reason.find("goal reached"), std::string::npos) << p.last_status().reason;
+  EXPECT_EQ(when, arrived + dwell) << "not at the slot after it, t + 500 ms";
+}
+
 TEST(Planner, ReplansWhenThePathIsBlocked) {
   CorridorStart start;
   auto& [g, p, t, first] = start;

@@ -27,4 +27,10 @@ FallbackSpline make_fallback_spline(const std::vector<Eigen::Vector3d>& points,
                                     const Eigen::Vector3d& start_velocity, double max_speed,
                                     double max_acceleration, double knot_interval);
 
+// The polyline that fallback flies: points[0], where braking stops and where it returns to the
+// first segment (when moving), then points[1...].
+std::vector<Eigen::Vector3d> fallback_route(const std::vector<Eigen::Vector3d>& points,
+                                            const Eigen::Vector3d& start_velocity, double max_acceleration,
+                                            double knot_interval);
+
 }  // namespace semx::controller

@@ -41,6 +41,7 @@ struct GenerationResult {
   OptimizerReport optimizer;
   ClearanceReport clearance;  // of the returned trajectory, or of the last one tried
   double time_scale = 1.0;    // knot interval stretch applied for the limits
+  bool slowed = false;        // optimised at the fallback's cruise speed (the full-speed curve failed)
 };
 
 class TrajectoryGenerator {
@@ -75,9 +76,11 @@ class TrajectoryGenerator {
   double speed_limit(double max_speed) const;
 
   // Step 1 alone: the optimiser's starting point (also what the perf tool times it from), and
-  // the times the polyline's points are passed on it.
+  // the times the polyline's points are passed on it. It cruises at v_max and starts at the
+  // vehicle's velocity, no faster than max(v_max, v_start).
   PositionSpline initial_spline(const std::vector<Eigen::Vector3d>& polyline, const StartState& start,
-                                double v_max, std::vector<double>* point_times = nullptr) const;
+                                double v_max, std::vector<double>* point_times = nullptr,
+                                double v_start = 0.0) const;
 
  private:
   // The vehicle's velocity (zero when not finite), no faster than v_max: where both curves start.

@@ -102,6 +102,10 @@ class ExplorationPlanner {
   };
   void run_cycle(int64_t utime);
   void release(Output& out, int64_t utime);
+  // Whether the vehicle is within tolerance of the goal, and since when (arrived_utime_).
+  void track_arrival(int64_t utime);
+  // When the goal counts as reached: dwell_s after the arrival, or after utime if not arrived.
+  int64_t reached_utime(int64_t utime) const;
   bool goal_reached(int64_t utime);
   // The controller has held the path's end for short_hold_s with the vehicle away from the goal.
   bool held_short(int64_t utime);
