@@ -139,7 +139,8 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   error_count_ = 0;
   status_.plan_id = path.plan_id;
   status_.state = ControllerState::kTracking;
-  status_.reason = trajectory_->optimized && !last_generation_.slowed ? "optimised trajectory" : last_generation_.reason;
+  status_.reason =
+      trajectory_->optimized && !last_generation_.slowed ? "optimised trajectory" : last_generation_.reason;
   out.new_trajectory = &*trajectory_;
 }
 

@@ -132,50 +132,56 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
   const double a_max = config_.limits.max_acceleration;
   const double dt = config_.trajectory.knot_interval;
 
+  const double v_fallback = v_max * config_.trajectory.fallback_speed_factor;
+  const Eigen::Vector3d v0 = start_velocity(start, v_max);
   std::string why;
   if (config_.optimizer.max_iterations > 0) {
-    // A curve that strays or comes too close at full speed is tried once more at the fallback's
-    // cruise speed: a corner is cut by about v²/a, so a quarter as far at half the speed, and the
-    // curve still does not stop at every waypoint as the fallback does.
-    const double slow = v_max * config_.trajectory.fallback_speed_factor;
-    for (const double cruise : {v_max, slow}) {
-      if (cruise != v_max && (!(slow < v_max) || result.cause == FallbackCause::kOptimizerFailed)) break;
+    // The deviation is measured from where the fallback would fly, braking ray included.
+    const std::vector<Eigen::Vector3d> route = fallback_route(polyline, v0, a_max, dt);
+    // One optimised curve cruising at `cruise` (starting at the vehicle's velocity); on failure,
+    // says why in `attempt` and `cause`.
+    std::string attempt;
+    FallbackCause cause = FallbackCause::kNone;
+    const auto optimised = [&](double cruise) {
       std::vector<double> times;
       Trajectory smooth;
       smooth.optimized = true;
       smooth.position = initial_spline(polyline, start, cruise, &times, v_max);
       result.optimizer = optimizer_.optimize(smooth.position, field, v_max, a_max,
                                              config_.clearance.bound() + config_.optimizer.target_margin);
-      std::string attempt;
-      FallbackCause cause = FallbackCause::kNone;
       if (result.optimizer.failed) {
         attempt = "optimiser failed (" + result.optimizer.message + ")";
         cause = FallbackCause::kOptimizerFailed;
-      } else if (const double off = deviation(
-                     smooth.position, fallback_route(polyline, start_velocity(start, v_max), a_max, dt));
+      } else if (const double off = deviation(smooth.position, route);
                  off > config_.trajectory.max_deviation) {
         std::ostringstream s;
-        s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off << " m from the path";
+        s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off
+          << " m from the path";
         attempt = s.str();
         cause = FallbackCause::kStrays;
       } else if (finish(smooth, times, yaws, v_max, field, result)) {
         result.ok = true;
-        result.slowed = cruise != v_max;
         result.trajectory = std::move(smooth);
-        if (result.slowed) {
-          std::ostringstream s;
-          s << "optimised at " << std::setprecision(3) << cruise << " m/s: " << why;
-          result.reason = s.str();
-        }
-        return result;
+        return true;
       } else {
         attempt = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
         cause = FallbackCause::kTooClose;
       }
-      if (cruise == v_max) {  // the full-speed attempt says why the vehicle does not fly it
-        why = attempt;
-        result.cause = cause;
-      }
+      return false;
+    };
+    if (optimised(v_max)) return result;
+    // The full-speed attempt says why the vehicle does not fly it.
+    why = attempt;
+    result.cause = cause;
+    // Tried once more at the fallback's cruise speed: a corner is cut by about v²/a, so a quarter
+    // as far at half the speed, and the curve still does not stop at every waypoint as the
+    // fallback does.
+    if (v_fallback < v_max && result.cause != FallbackCause::kOptimizerFailed && optimised(v_fallback)) {
+      result.slowed = true;
+      std::ostringstream s;
+      s << "optimised at " << std::setprecision(3) << v_fallback << " m/s: " << why;
+      result.reason = s.str();
+      return result;
     }
   } else {
     why = "optimiser disabled";
@@ -185,7 +191,6 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
   // The fallback brakes from the vehicle's velocity first, as the vehicle will. Where that ray
   // is too close to an obstacle, the fallback at rest on the path is still the best reference:
   // the tracker then brakes as hard as the vehicle can, and no reference can stop it sooner.
-  const double v_fallback = v_max * config_.trajectory.fallback_speed_factor;
   const auto fallback = [&](const Eigen::Vector3d& v) {
     FallbackSpline fb = make_fallback_spline(polyline, v, v_fallback, a_max, dt);
     Trajectory safe;
@@ -197,7 +202,6 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
     result.reason = "fallback: " + why;
     return true;
   };
-  const Eigen::Vector3d v0 = start_velocity(start, v_max);
   if (fallback(v0) || (!v0.isZero() && fallback(Eigen::Vector3d::Zero()))) return result;
   result.reason = "no safe trajectory: " + why + "; the path itself: " + describe(result.clearance);
   return result;

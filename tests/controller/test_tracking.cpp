@@ -55,11 +55,7 @@ TEST(Tracking, ConvergesFromAnOffsetStartOnAPointMass) {
   loop.send_path({{0, 0, 1}, {6, 0, 1}}, {0, 0}, 1);
   loop.run(0.5);
   // The trajectory starts at the vehicle, so the error is small from the start and stays so.
-  double worst = 0;
-  while (loop.controller.status().state == ControllerState::kTracking) {
-    loop.step();
-    worst = std::max(worst, loop.last.status.tracking_error);
-  }
+  const double worst = loop.track_to_end();
   EXPECT_EQ(loop.controller.status().state, ControllerState::kHolding);
   EXPECT_LT(worst, 0.1);
   loop.run(3.0);
@@ -81,11 +77,7 @@ TEST(Tracking, AFallbackTakenWhileMovingIsFlownAsPlanned) {
   loop.send_path({loop.vehicle.position, {0.4, -0.45, 1.9}, {1.4, -1.0, 2.0}}, {0, 0, 0}, 1);
   loop.step();
   ASSERT_EQ(loop.controller.status().state, ControllerState::kTracking) << loop.controller.status().reason;
-  double worst = 0;
-  while (loop.controller.status().state == ControllerState::kTracking) {
-    loop.step();
-    worst = std::max(worst, loop.last.status.tracking_error);
-  }
+  const double worst = loop.track_to_end();
   EXPECT_EQ(loop.controller.status().state, ControllerState::kHolding);
   EXPECT_LT(worst, 0.06);
 }

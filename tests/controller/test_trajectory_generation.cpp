@@ -46,6 +46,21 @@ double distance_to_polyline(const std::vector<Eigen::Vector3d>& pts, const Eigen
   return best;
 }
 
+// The fallback as a trajectory, checking that it is at pts[i], at rest, at point_times[i] for
+// every i >= from.
+Trajectory stops_at_every_point(const FallbackSpline& fb, const std::vector<Eigen::Vector3d>& pts,
+                                std::size_t from) {
+  EXPECT_EQ(fb.point_times.size(), pts.size());
+  Trajectory t;
+  t.position = fb.spline;
+  for (std::size_t i = from; i < std::min(pts.size(), fb.point_times.size()); ++i) {
+    const TrajectoryPoint p = t.sample(fb.point_times[i]);
+    EXPECT_LT((p.position - pts[i]).norm(), 1e-12) << i;
+    EXPECT_LT(p.velocity.norm(), 1e-12) << i;
+  }
+  return t;
+}
+
 std::vector<double> unwrapped(std::vector<double> yaws) {
   for (std::size_t k = 1; k < yaws.size(); ++k) yaws[k] = unwrap_near(yaws[k], yaws[k - 1]);
   return yaws;
@@ -304,14 +319,7 @@ TEST(TrajectoryGeneration, AVehicleTooCloseToAWallMayOnlyEscape) {
 TEST(Fallback, StopsAtEveryWaypointWithinTheLimits) {
   const std::vector<Eigen::Vector3d> pts{{0, 0, 0}, {1, 0, 0}, {1, 0.05, 0}, {3, 2, 1}};
   const FallbackSpline fb = make_fallback_spline(pts, Eigen::Vector3d::Zero(), 0.5, 2.0, 0.25);
-  ASSERT_EQ(fb.point_times.size(), pts.size());
-  Trajectory t;
-  t.position = fb.spline;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const TrajectoryPoint p = t.sample(fb.point_times[i]);
-    EXPECT_LT((p.position - pts[i]).norm(), 1e-12) << i;
-    EXPECT_LT(p.velocity.norm(), 1e-12) << i;
-  }
+  const Trajectory t = stops_at_every_point(fb, pts, 0);
   const Extremes e = sample_all(t);
   EXPECT_LE(e.speed, 0.5 * (1 + 1e-9));
   EXPECT_LE(e.acceleration, 2.0 * (1 + 1e-9));
@@ -323,17 +331,10 @@ TEST(Fallback, AMovingStartBrakesAlongItsVelocityThenReturnsToThePath) {
   const Eigen::Vector3d v0(0, 0, -0.9);
   const double a = 2.0;
   const FallbackSpline fb = make_fallback_spline(pts, v0, 0.5, a, 0.25);
-  ASSERT_EQ(fb.point_times.size(), pts.size());
-  Trajectory t;
-  t.position = fb.spline;
+  const Trajectory t = stops_at_every_point(fb, pts, 1);
   const TrajectoryPoint p0 = t.sample(0.0);
   EXPECT_LT((p0.position - pts[0]).norm(), 1e-12);
   EXPECT_LT((p0.velocity - v0).norm(), 1e-12);
-  for (std::size_t i = 1; i < pts.size(); ++i) {
-    const TrajectoryPoint p = t.sample(fb.point_times[i]);
-    EXPECT_LT((p.position - pts[i]).norm(), 1e-12) << i;
-    EXPECT_LT(p.velocity.norm(), 1e-12) << i;
-  }
   const Extremes e = sample_all(t);
   EXPECT_LE(e.speed, 0.9 * (1 + 1e-9));
   EXPECT_LE(e.acceleration, a * (1 + 1e-9));

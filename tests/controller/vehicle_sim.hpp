@@ -82,6 +82,15 @@ struct Loop {
   void run(double seconds) {
     for (int i = 0; i < static_cast<int>(seconds * 100 + 0.5); ++i) step();
   }
+  // Steps while the controller is TRACKING; returns the largest tracking error seen.
+  double track_to_end() {
+    double worst = 0;
+    while (controller.status().state == ControllerState::kTracking) {
+      step();
+      worst = std::max(worst, last.status.tracking_error);
+    }
+    return worst;
+  }
   // Steps until `pred` or `seconds` pass; returns whether pred held.
   template <class F>
   bool run_until(F pred, double seconds) {
