@@ -3,12 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-namespace {
-// Below this |∇distance| (a ridge between obstacles, e.g. a doorway's centre line) the nearest
-// obstacle's direction is unknown and only `bound` applies.
-constexpr double kMinGradient = 0.5;
-}  // namespace
-
 namespace semx::controller {
 
 double footprint_reach(const Eigen::Vector3d& n, double yaw, double half_xy, double half_z) {
@@ -75,7 +69,7 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
       fail(t, p, d);
       return r;
     }
-    if (!escaping && footprint && g.norm() > kMinGradient) {
+    if (!escaping && footprint && g.norm() > kRidgeGradient) {
       // The gradient points away from the nearest obstacle; the reach is symmetric.
       const double deficit = footprint_reach(g.normalized(), trajectory.yaw.evaluate(t, 0)(0),
                                              rule.footprint_half_xy, rule.footprint_half_z) +

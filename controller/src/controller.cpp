@@ -123,6 +123,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   ++counters_.trajectories;
   ++(trajectory_->optimized ? counters_.optimized : counters_.fallbacks);
   if (last_generation_.slowed) ++counters_.slowed;
+  counters_.squared_headings += last_generation_.squared_headings;
   if (!trajectory_->optimized) {
     switch (last_generation_.cause) {
       case FallbackCause::kStrays:

@@ -20,6 +20,7 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   cl.get("half_height", c.clearance.half_height, 0.0, 5.0);
   cl.get("footprint_margin", c.clearance.footprint_margin, 0.0, 5.0);
   cl.get("turned_body", c.clearance.turned_body);
+  cl.get("square_headings", c.clearance.square_headings);
   cl.get("check_spacing", c.clearance.check_spacing, 0.001, 0.5);
   cl.get("allow_escape", c.clearance.allow_escape);
   std::string outside = c.clearance.outside_is_obstacle ? "obstacle" : "free";

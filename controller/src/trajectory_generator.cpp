@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "semx/controller/body_heading.hpp"
 #include "semx/controller/fallback.hpp"
 #include "semx/controller/time_allocation.hpp"
 #include "semx/controller/yaw_profile.hpp"
@@ -125,9 +126,14 @@ double TrajectoryGenerator::deviation(const PositionSpline& curve,
 }
 
 GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d>& polyline,
-                                               const std::vector<double>& yaws, const StartState& start,
+                                               const std::vector<double>& path_yaws, const StartState& start,
                                                double max_speed, const DistanceField& field) const {
   GenerationResult result;
+  std::vector<double> yaws = path_yaws;
+  if (config_.clearance.square_headings) {
+    result.squared_headings =
+        square_headings_near_obstacles(polyline, yaws, field, config_.clearance.square_within());
+  }
   const double v_max = speed_limit(max_speed);
   const double a_max = config_.limits.max_acceleration;
   const double dt = config_.trajectory.knot_interval;

@@ -29,6 +29,10 @@ struct ClearanceRule {
   double footprint_margin = 0.0;   // m
 };
 
+// Below this |∇distance| (a ridge between obstacles, e.g. a doorway's centre line) the nearest
+// obstacle's direction is unknown: only `bound` applies, and no heading is squared to it.
+constexpr double kRidgeGradient = 0.5;
+
 // How far a box of half sizes (half_xy, half_xy, half_z), turned by `yaw`, reaches along the
 // unit direction n (world frame).
 double footprint_reach(const Eigen::Vector3d& n, double yaw, double half_xy, double half_z);

@@ -6,6 +6,8 @@
 // trajectory, optimizer, path, tracking, safety), keys named as the fields.
 #pragma once
 
+#include <cmath>
+
 #include "semx/runtime/config.hpp"
 
 namespace semx::controller {
@@ -43,6 +45,11 @@ struct ClearanceConfig {
   double half_height = 0.15;       // m, the body box's (0.3 m high)
   double footprint_margin = 0.02;  // m
   bool turned_body = true;
+  // Turn the heading at each path point closer to an obstacle than a corner's reach (√2 half_size
+  // + footprint_margin) by at most 45°, so that a face of the body looks at the obstacle there
+  // (body_heading.hpp). For every trajectory, the fallback too: it is the one that follows the
+  // path through its doorway and passage points exactly.
+  bool square_headings = true;
   double check_spacing = 0.02;  // m, arc length between dense clearance samples
   // A trajectory that starts below the bound (the vehicle already is) may climb out of it
   // without getting closer than its start; otherwise such a vehicle could never move again.
@@ -52,6 +59,8 @@ struct ClearanceConfig {
 
   double bound() const { return half_size + margin; }
   double brake_bound() const { return half_size + brake_margin; }
+  // ESDF distance below which square_headings turns a path point's heading.
+  double square_within() const { return std::sqrt(2.0) * half_size + footprint_margin; }
 };
 
 struct TrajectoryConfig {

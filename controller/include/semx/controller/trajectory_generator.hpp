@@ -42,6 +42,7 @@ struct GenerationResult {
   ClearanceReport clearance;  // of the returned trajectory, or of the last one tried
   double time_scale = 1.0;    // knot interval stretch applied for the limits
   bool slowed = false;        // optimised at the fallback's cruise speed (the full-speed curve failed)
+  int squared_headings = 0;   // path points whose heading was turned to face an obstacle
 };
 
 class TrajectoryGenerator {

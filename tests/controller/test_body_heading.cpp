@@ -1,0 +1,88 @@
+// Headings squared to the obstacles a path passes close to (body_heading.hpp).
+#include <gtest/gtest.h>
+
+#include "fields.hpp"
+#include "semx/controller/body_heading.hpp"
+#include "semx/controller/clearance.hpp"
+#include "semx/controller/controller_config.hpp"
+#include "semx/controller/trajectory_generator.hpp"
+
+namespace semx::controller {
+namespace {
+
+using test::FreeField;
+using test::PostField;
+
+constexpr double kHalf = 0.25;
+
+double reach_toward_post(const Eigen::Vector3d& p, const Eigen::Vector2d& post, double yaw) {
+  const Eigen::Vector2d d = (post - p.head<2>()).normalized();
+  return footprint_reach(Eigen::Vector3d(d.x(), d.y(), 0.0), yaw, kHalf, 0.15);
+}
+
+TEST(BodyHeading, APointBesideAnEdgeTurnsTheBodyToFaceIt) {
+  // A door leaf's edge 0.36 m beside the middle point, the path heading diagonally: the corner
+  // would reach 0.354 m toward it. Only that point turns, by 45°, to a face.
+  const Eigen::Vector2d post(2.0, 0.36);
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {2, 0, 1}, {4, 0, 1}};
+  std::vector<double> yaws = {M_PI / 4, M_PI / 4, M_PI / 4};
+  ASSERT_GT(reach_toward_post(pts[1], post, yaws[1]), 0.35);
+  EXPECT_EQ(square_headings_near_obstacles(pts, yaws, PostField(post), std::sqrt(2.0) * kHalf + 0.02), 1);
+  EXPECT_DOUBLE_EQ(yaws[0], M_PI / 4);
+  EXPECT_DOUBLE_EQ(yaws[2], M_PI / 4);
+  EXPECT_NEAR(std::abs(yaws[1] - M_PI / 4), M_PI / 4, 1e-9) << "a quarter turn at most, the smallest";
+  EXPECT_NEAR(reach_toward_post(pts[1], post, yaws[1]), kHalf, 1e-9);
+}
+
+TEST(BodyHeading, TurnsByTheSmallestAngleAndKeepsHeadingsUnwrapped) {
+  const Eigen::Vector2d post(0.0, 0.3);  // straight +y of the point
+  const std::vector<Eigen::Vector3d> pts = {{5, 5, 1}, {0, 0, 1}};
+  for (const double yaw : {0.3, -0.3, 1.2, 2.0, 20 * M_PI + 0.3, -20 * M_PI - 2.0}) {
+    std::vector<double> yaws = {0.0, yaw};
+    square_headings_near_obstacles(pts, yaws, PostField(post), 0.4);
+    EXPECT_LE(std::abs(yaws[1] - yaw), M_PI / 4 + 1e-9) << yaw;
+    EXPECT_NEAR(std::remainder(yaws[1], M_PI / 2), 0.0, 1e-9) << yaw << " -> " << yaws[1];
+  }
+}
+
+TEST(BodyHeading, LeavesPointsWithRoomOrOnARidgeAlone) {
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {1, 0, 1}, {2, 0, 1}};
+  std::vector<double> yaws = {0.7, 0.7, 0.7};
+  // The start is the vehicle's heading, whatever is near it; the others have 0.5 m of room.
+  EXPECT_EQ(square_headings_near_obstacles(pts, yaws, PostField(Eigen::Vector2d(0.0, 0.1)), 0.374), 0);
+  EXPECT_EQ(square_headings_near_obstacles(pts, yaws, PostField(Eigen::Vector2d(1.0, 0.5)), 0.374), 0);
+  // A doorway's centre line: close, but no direction to face.
+  EXPECT_EQ(square_headings_near_obstacles(pts, yaws, FreeField(0.3), 0.374), 0);
+  EXPECT_EQ(square_headings_near_obstacles(pts, yaws, PostField(Eigen::Vector2d(1.0, 0.3)), 0.0), 0);
+  EXPECT_EQ(yaws, std::vector<double>({0.7, 0.7, 0.7}));
+}
+
+TEST(BodyHeading, TheFallbackThroughATightPointKeepsTheTurnedBodyOffTheEdge) {
+  // The DEP collision of env3, seed 2: the fallback (the path exactly) through a point 0.36 m
+  // from an edge, heading diagonally. With square_headings its body faces the edge there and the
+  // whole curve passes the turned-body rule; without, it does not.
+  ControllerConfig cfg;
+  cfg.optimizer.max_iterations = 0;  // the fallback
+  const Eigen::Vector2d edge(2.0, 0.36);
+  const PostField field(edge);
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {2, 0, 1}, {4, 0, 1}};
+  const std::vector<double> yaws = {M_PI / 4, M_PI / 4, M_PI / 4};
+  StartState start;
+  start.position = pts[0];
+  start.yaw = yaws[0];
+  const TrajectoryGenerator squared(cfg);
+  const GenerationResult r = squared.generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.squared_headings, 1);
+  const ClearanceRule body = squared.flight_rule(true);
+  EXPECT_TRUE(check_clearance(r.trajectory, field, 0, r.trajectory.duration(), body).ok);
+
+  cfg.clearance.square_headings = false;
+  const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(plain.ok) << plain.reason;
+  EXPECT_EQ(plain.squared_headings, 0);
+  EXPECT_FALSE(check_clearance(plain.trajectory, field, 0, plain.trajectory.duration(), body).ok);
+}
+
+}  // namespace
+}  // namespace semx::controller
