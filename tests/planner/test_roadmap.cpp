@@ -212,6 +212,23 @@ TEST(Collision, RootEdgesMayLeaveUnmappedSurroundings) {
   EXPECT_FALSE(c.root_edge_free(root, goal));
 }
 
+TEST(Collision, ARootWhoseBoxCornerTouchesAVoxelMayMoveAwayFromIt) {
+  // A door leaf's edge (one occupied column) overlapping the corner of the bare vehicle box at the
+  // root, 0.3 m away in the ESDF: the vehicle braked there (env3, dep, seed 4) and had no edge
+  // to any node, DONE at 39 %. It may leave without coming closer, not pass the edge.
+  mapper::StateGrid g = known_room();
+  fill_m(g, {3.2, 2.2, 0.0}, {3.3, 2.3, 2.5}, VoxelState::kOccupied);
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  const Eigen::Vector3d root(3, 2, 1.2);
+  ASSERT_FALSE(c.vehicle_free(root));
+  ASSERT_GT(c.esdf(root, 0.42, false), 0.25);
+  EXPECT_TRUE(c.root_edge_free(root, {1.5, 1.2, 1.2}));
+  EXPECT_TRUE(c.root_edge_free(root, {3.0, 0.8, 1.2}));
+  EXPECT_FALSE(c.root_edge_free(root, {4.5, 2.8, 1.2})) << "past the edge, closer than the root";
+  EXPECT_FALSE(c.edge_free(root, {1.5, 1.2, 1.2})) << "only the root escapes";
+}
+
 // DEP's roadmap over cycles on a partly known map.
 struct DepFixture {
   PlannerConfig config = test_config("dep");

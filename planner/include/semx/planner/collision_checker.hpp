@@ -13,9 +13,10 @@
 //                    controller's dense check requires (0.32 m + 0.017 m pad) holds all along;
 //   root_edge_free(root, b): edge_free when the root itself is node_free; otherwise points within
 //                    root_escape_radius of the root are checked with the bare vehicle box against
-//                    occupied voxels only: the vehicle may leave a pose whose surroundings are not
-//                    mapped yet (the camera never sees the cone above and below itself) or that
-//                    drifted close to a wall.
+//                    occupied voxels only, or, where that box overlaps one, with the ESDF: no
+//                    closer than the root, farther than the half width: the vehicle may leave a
+//                    pose whose surroundings are not mapped yet (the camera never sees the cone
+//                    above and below itself) or that drifted close to a wall.
 //
 // The centre line is first walked voxel by voxel (no occupied or unknown voxel on it), which
 // rejects edges through walls and into unknown space for the price of one ray.
@@ -61,6 +62,9 @@ class CollisionChecker {
   // m: in doorways, ESDF distance kept from unknown voxels (the body's half width + 5 cm; the
   // controller does not see them, door_clearance applies to occupied ones).
   static constexpr double kDoorUnknownClearance = 0.3;
+  // m: how much closer to the obstacles than the root a point within root_escape_radius may be
+  // when its bare box overlaps an occupied voxel (the controller's escape_slack).
+  static constexpr double kEscapeSlack = 0.01;
   // Moves p away from the occupied and unknown voxels within `clearance` of it (each pushes by
   // how much it intrudes, along the line from its cube's nearest point), up to `iterations` times
   // and by at most max_step each; true when p ends node_free (passage_free with `passage`).
