@@ -419,8 +419,8 @@ bool CollisionChecker::samples_free(const Eigen::Vector3d& a, const Eigen::Vecto
   // the controller's measure) than the root itself, and farther than the body's half width. A
   // vehicle that braked with its box's corner touching a voxel of a door leaf was otherwise cut off
   // from every node, 0.17 m away or not, and DONE at 39 % (env3, dep, seed 4, at 26 s).
-  const double floor = escape_radius > 0 ? std::max(vehicle_half_.x(), esdf(a, config_.passage_clearance, false) -
-                                                                           kEscapeSlack)
+  const double floor = escape_radius > 0 ? std::max(vehicle_half_.x(),
+                                                    esdf(a, config_.passage_clearance, false) - kEscapeSlack)
                                          : 0.0;
   const auto escapes = [&](const Eigen::Vector3d& p) {
     return vehicle_free(p) || esdf(p, config_.passage_clearance, false) >= floor;
