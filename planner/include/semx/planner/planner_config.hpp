@@ -101,7 +101,7 @@ struct GainConfig {
   int yaw_bins = 32;        // azimuth histogram (DEP)
   int rays_azimuth = 128;   // gain rays around the node (a multiple of yaw_bins)
   int rays_elevation = 10;  // rays across the vertical field of view
-  double min_gain = 50.0;   // a node with G below this is not a goal (weighted voxels)
+  double min_gain = 1000.0;  // a node with G below this is not a goal (weighted voxels)
 
   double horizontal_fov() const;  // rad
   double vertical_fov() const;    // rad
