@@ -164,7 +164,9 @@ struct AepConfig {
   double lambda = 0.5;         // 1/m
   double radius = 5.0;         // m, local sampling box half width
   double cache_radius = 0.3;   // m, a cached gain this close to a tree node is reused
-  double g_zero = 100.0;       // local gain below this triggers the frontier fallback
+  // Local gain below this triggers the frontier fallback. Below gain.min_gain it has no effect (a
+  // local goal needs min_gain anyway), so it defaults to the same 1000.
+  double g_zero = 1000.0;
 };
 
 struct PlannerConfig {
