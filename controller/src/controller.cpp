@@ -124,6 +124,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   ++(trajectory_->optimized ? counters_.optimized : counters_.fallbacks);
   if (last_generation_.slowed) ++counters_.slowed;
   counters_.squared_headings += last_generation_.squared_headings;
+  counters_.repaired_headings += last_generation_.repaired_headings;
   if (!trajectory_->optimized) {
     switch (last_generation_.cause) {
       case FallbackCause::kStrays:

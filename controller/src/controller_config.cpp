@@ -21,6 +21,8 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   cl.get("footprint_margin", c.clearance.footprint_margin, 0.0, 5.0);
   cl.get("turned_body", c.clearance.turned_body);
   cl.get("square_headings", c.clearance.square_headings);
+  cl.get("heading_repairs", c.clearance.heading_repairs, 0, 100);
+  cl.get("heading_hold", c.clearance.heading_hold, 0.01, 10.0);
   cl.get("check_spacing", c.clearance.check_spacing, 0.001, 0.5);
   cl.get("allow_escape", c.clearance.allow_escape);
   std::string outside = c.clearance.outside_is_obstacle ? "obstacle" : "free";

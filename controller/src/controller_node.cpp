@@ -67,7 +67,7 @@ int ControllerNode::run() {
   std::cout << "semx-controller: paths " << c.paths << ", trajectories " << c.trajectories << " (optimised "
             << c.optimized << " (slowed " << c.slowed << "), fallback " << c.fallbacks << ": strayed "
             << c.fallback_strays << ", too close " << c.fallback_too_close << "), squared headings "
-            << c.squared_headings << ", rejected " << c.rejected << ", unsafe " << c.unsafe << ", brakes "
+            << c.squared_headings << ", repaired headings " << c.repaired_headings << ", rejected " << c.rejected << ", unsafe " << c.unsafe << ", brakes "
             << c.brakes << ", stale stops " << c.stale_stops << std::endl;
   return code;
 }

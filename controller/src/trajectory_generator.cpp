@@ -63,9 +63,25 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   trajectory.position.set_knot_interval(trajectory.knot_interval() * k);
   std::vector<double> scaled(times);
   for (double& t : scaled) t *= k;
-  add_yaw_profile(trajectory, scaled, yaws, config_.limits.max_yaw_rate);
-  result.clearance =
-      check_clearance(trajectory, field, 0.0, trajectory.duration(), generation_rule(trajectory.optimized));
+  std::vector<double> targets(yaws);
+  const ClearanceRule rule = generation_rule(trajectory.optimized);
+  // Only the turned-body rule depends on the heading, and only optimised curves are held to it.
+  const int repairs = rule.footprint_half_xy > 0.0 ? config_.clearance.heading_repairs : 0;
+  const PositionSpline curve = trajectory.position;  // the yaw profile may add a hover at its end
+  for (int attempt = 0;; ++attempt) {
+    trajectory.position = curve;
+    add_yaw_profile(trajectory, scaled, targets, config_.limits.max_yaw_rate);
+    result.clearance = check_clearance(trajectory, field, 0.0, trajectory.duration(), rule);
+    if (result.clearance.ok || !result.clearance.footprint || attempt >= repairs) break;
+    const double t = result.clearance.violation_time;
+    Eigen::Vector3d g;
+    field.distance(result.clearance.violation_point, &g);
+    if (!hold_heading_square_at(scaled, targets, t, trajectory.yaw.evaluate(t, 0)(0), g,
+                                config_.clearance.heading_hold))
+      break;
+    ++result.repaired_headings;
+  }
+  if (!result.clearance.ok) result.repaired_headings = 0;
   return result.clearance.ok;
 }
 

@@ -84,5 +84,78 @@ TEST(BodyHeading, TheFallbackThroughATightPointKeepsTheTurnedBodyOffTheEdge) {
   EXPECT_FALSE(check_clearance(plain.trajectory, field, 0, plain.trajectory.duration(), body).ok);
 }
 
+TEST(BodyHeading, HoldingTheHeadingSquareReplacesTheKnotsAroundTheInstant) {
+  std::vector<double> times = {0.0, 1.0, 2.0, 3.0, 4.0};
+  std::vector<double> yaws = {0.0, 0.7, 0.7, 0.7, 0.7};
+  // The obstacle along +y: a face looks along it at every quarter turn; the nearest to 0.7 rad is 0.
+  ASSERT_TRUE(hold_heading_square_at(times, yaws, 2.1, 0.7, Eigen::Vector3d(0, 1, 0), 0.3));
+  EXPECT_EQ(times, std::vector<double>({0.0, 1.0, 1.8, 2.4, 3.0, 4.0}));
+  ASSERT_EQ(yaws.size(), 6u);
+  EXPECT_NEAR(yaws[2], 0.0, 1e-12);
+  EXPECT_NEAR(yaws[3], 0.0, 1e-12);
+  EXPECT_EQ(yaws.front(), 0.0);
+  EXPECT_EQ(yaws.back(), 0.7);
+  // Near the ends the hold shrinks so the vehicle's and the goal's headings stay first and last.
+  std::vector<double> t2 = {0.0, 1.0}, y2 = {0.0, 0.0};
+  ASSERT_TRUE(hold_heading_square_at(t2, y2, 0.9, 0.2, Eigen::Vector3d(1, 0, 0), 0.3));
+  EXPECT_EQ(t2.front(), 0.0);
+  EXPECT_EQ(t2.back(), 1.0);
+  EXPECT_EQ(y2.back(), 0.0);
+  EXPECT_NEAR(y2[1], 0.0, 1e-12);
+  // Unknown direction (a ridge) or an instant outside the target: nothing to do.
+  std::vector<double> t3 = times, y3 = yaws;
+  EXPECT_FALSE(hold_heading_square_at(t3, y3, 2.1, 0.7, Eigen::Vector3d(0.1, 0.1, 0), 0.3));
+  EXPECT_FALSE(hold_heading_square_at(t3, y3, 4.5, 0.7, Eigen::Vector3d(0, 1, 0), 0.3));
+  EXPECT_EQ(t3, times);
+}
+
+// The two jambs of a doorway, vertical posts at (x, ±half_gap): the distance to the nearer one.
+class DoorwayField : public DistanceField {
+ public:
+  DoorwayField(double x, double half_gap)
+      : a_(Eigen::Vector2d(x, half_gap)), b_(Eigen::Vector2d(x, -half_gap)) {}
+  double distance(const Eigen::Vector3d& p, Eigen::Vector3d* g = nullptr) const override {
+    const double da = a_.distance(p, g);
+    Eigen::Vector3d gb;
+    const double db = b_.distance(p, &gb);
+    if (db < da && g) *g = gb;
+    return std::min(da, db);
+  }
+  double lipschitz() const override { return 1.0; }
+
+ private:
+  PostField a_, b_;
+};
+
+TEST(BodyHeading, AnOptimisedCurveThroughADoorwayHoldsItsHeadingSquareInsteadOfTakingTheFallback) {
+  // A doorway 0.72 m between the jambs' ends (ESDF 0.36 on its centre line), no path point in it,
+  // the camera looking 45° off the direction of travel: the corner would reach 0.374 m toward a
+  // jamb. Without the repair the whole path goes to the fallback (half speed, a stop at every
+  // waypoint); with it the optimised curve is flown, its body square to the jambs in the doorway.
+  const DoorwayField field(2.0, 0.36);
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {1.2, 0, 1}, {2.8, 0, 1}, {4, 0, 1}};
+  const std::vector<double> yaws(pts.size(), M_PI / 4);
+  StartState start;
+  start.position = pts[0];
+  start.yaw = yaws[0];
+  ControllerConfig cfg;
+  cfg.clearance.heading_repairs = 0;
+  const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(plain.ok) << plain.reason;
+  EXPECT_FALSE(plain.trajectory.optimized);
+  EXPECT_EQ(plain.cause, FallbackCause::kTooClose);
+
+  cfg.clearance.heading_repairs = 8;
+  const TrajectoryGenerator gen(cfg);
+  const GenerationResult r = gen.generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_TRUE(r.trajectory.optimized) << r.reason;
+  EXPECT_GE(r.repaired_headings, 1);
+  EXPECT_TRUE(check_clearance(r.trajectory, field, 0, r.trajectory.duration(), gen.generation_rule(true)).ok);
+  EXPECT_LT(r.trajectory.duration(), 0.6 * plain.trajectory.duration());
+  // The goal keeps the heading the planner asked for.
+  EXPECT_NEAR(r.trajectory.yaw.evaluate(r.trajectory.duration(), 0)(0), yaws.back(), 1e-9);
+}
+
 }  // namespace
 }  // namespace semx::controller

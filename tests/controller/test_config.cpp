@@ -28,6 +28,8 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(clearance.half_height);
   SAME(clearance.footprint_margin);
   SAME(clearance.turned_body);
+  SAME(clearance.heading_repairs);
+  SAME(clearance.heading_hold);
   SAME(trajectory.max_deviation);
   SAME(optimizer.max_iterations);
   SAME(optimizer.weight_smoothness);

@@ -50,6 +50,12 @@ struct ClearanceConfig {
   // (body_heading.hpp). For every trajectory, the fallback too: it is the one that follows the
   // path through its doorway and passage points exactly.
   bool square_headings = true;
+  // An optimised curve cuts corners, so it can pass an obstacle closer than a corner's reach where
+  // no path point does. Where it breaks the turned-body rule, the heading target is held square to
+  // that obstacle for heading_hold s on either side of the instant and the curve checked again, at
+  // most heading_repairs times (body_heading.hpp), before the slower curves are tried. 0: off.
+  int heading_repairs = 8;
+  double heading_hold = 0.3;    // s
   double check_spacing = 0.02;  // m, arc length between dense clearance samples
   // A trajectory that starts below the bound (the vehicle already is) may climb out of it
   // without getting closer than its start; otherwise such a vehicle could never move again.

@@ -38,6 +38,7 @@ struct ControllerCounters {
   int64_t fallback_strays = 0;     //   strayed from the path (trajectory.max_deviation)
   int64_t fallback_too_close = 0;  //   failed the clearance check
   int64_t squared_headings = 0;    // path points whose heading was turned to face an obstacle
+  int64_t repaired_headings = 0;   // instants of flown optimised curves whose heading was held square
   int64_t brakes = 0;              // predicted collisions
   int64_t stale_stops = 0;         // entries into STALE_INPUT
 };

@@ -43,6 +43,7 @@ struct GenerationResult {
   double time_scale = 1.0;    // knot interval stretch applied for the limits
   bool slowed = false;        // optimised at the fallback's cruise speed (the full-speed curve failed)
   int squared_headings = 0;   // path points whose heading was turned to face an obstacle
+  int repaired_headings = 0;  // instants of the flown curve whose heading was held square (heading_repairs)
 };
 
 class TrajectoryGenerator {
