@@ -43,6 +43,8 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   o.get("weight_clearance", c.optimizer.weight_clearance, 0.0, 1e6);
   o.get("weight_feasibility", c.optimizer.weight_feasibility, 0.0, 1e6);
   o.get("target_margin", c.optimizer.target_margin, 0.0, 2.0);
+  o.get("weight_fidelity", c.optimizer.weight_fidelity, 0.0, 1e6);
+  o.get("fidelity_tolerance", c.optimizer.fidelity_tolerance, 0.0, 10.0);
   o.get("samples_per_segment", c.optimizer.samples_per_segment, 1, 20);
 
   auto p = m.child("path");

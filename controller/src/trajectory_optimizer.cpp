@@ -97,6 +97,21 @@ class Cost {
       }
     }
 
+    // Fidelity: control points pulled more than fidelity_tolerance from the initial curve (which
+    // follows the path) pay for it, so that smoothness cuts no corner beyond what the deviation
+    // rule flies.
+    const double wd = cfg_.weight_fidelity;
+    if (wd > 0) {
+      for (int i = 0; i < free_points(); ++i) {
+        const Eigen::Vector3d off = x.segment<3>(3 * i);
+        const double len = off.norm();
+        const double r = len - cfg_.fidelity_tolerance;
+        if (r <= 0) continue;
+        f += wd * r * r;
+        g_[kFixed + i] += 2.0 * wd * r / len * off;
+      }
+    }
+
     for (int i = 0; i < free_points(); ++i) grad.segment<3>(3 * i) = g_[kFixed + i];
     if (std::isfinite(f) && f < best_f_) {
       best_f_ = f;

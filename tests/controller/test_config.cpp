@@ -36,6 +36,8 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(optimizer.weight_clearance);
   SAME(optimizer.weight_feasibility);
   SAME(optimizer.target_margin);
+  SAME(optimizer.weight_fidelity);
+  SAME(optimizer.fidelity_tolerance);
   SAME(optimizer.samples_per_segment);
   SAME(path.max_waypoints);
   SAME(path.max_segment_length);

@@ -392,6 +392,30 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysIsSlowedThenTakesTheFallbac
   EXPECT_LT(slowed.trajectory.duration(), strict.trajectory.duration()) << "the slowed curve does not stop";
 }
 
+TEST(TrajectoryGeneration, TheFidelityTermKeepsTheFullSpeedCurveOnAZigzagPath) {
+  // Three 1.5 m legs at right angles: smoothness alone rounds the zigzag 0.46 m off the path, past
+  // max_deviation, and the curve is flown at half speed. Control points pay for offsets beyond
+  // fidelity_tolerance from the initial curve, and the full-speed curve stays on the path.
+  const std::vector<Eigen::Vector3d> zigzag = {{0, 0, 1}, {1.5, 0, 1}, {1.5, 1.5, 1}, {3, 1.5, 1}, {3, 0, 1}};
+  const std::vector<double> yaws(zigzag.size(), 0.0);
+  ControllerConfig cfg;
+  ASSERT_GT(cfg.optimizer.weight_fidelity, 0.0);
+  const GenerationResult kept =
+      TrajectoryGenerator(cfg).generate(zigzag, yaws, at_rest(zigzag[0]), 0.0, FreeField());
+  ASSERT_TRUE(kept.ok) << kept.reason;
+  EXPECT_TRUE(kept.trajectory.optimized);
+  EXPECT_FALSE(kept.slowed) << kept.reason;
+  EXPECT_LE(TrajectoryGenerator::deviation(kept.trajectory.position, zigzag), cfg.trajectory.max_deviation);
+
+  cfg.optimizer.weight_fidelity = 0.0;
+  const GenerationResult loose =
+      TrajectoryGenerator(cfg).generate(zigzag, yaws, at_rest(zigzag[0]), 0.0, FreeField());
+  ASSERT_TRUE(loose.ok) << loose.reason;
+  EXPECT_TRUE(loose.slowed);
+  EXPECT_NE(loose.reason.find("strays"), std::string::npos) << loose.reason;
+  EXPECT_LT(kept.trajectory.duration(), 0.7 * loose.trajectory.duration());
+}
+
 TEST(TrajectoryGeneration, OnlyOptimisedCurvesAnswerForTheTurnedBody) {
   // The fallback is the planner's own path (in a doorway, 0.35 m from the jambs in the ESDF, where
   // a body heading diagonally still fits the world): it keeps the plain bounds, and so does the

@@ -89,7 +89,12 @@ struct OptimizerConfig {
   double weight_clearance = 40.0;   // on squared distance below the clearance target (m²)
   double weight_feasibility = 1.0;  // on squared relative excess of velocity/acceleration
   double target_margin = 0.1;       // m, optimiser's target distance = clearance bound + this
-  int samples_per_segment = 2;      // curve points per knot interval in the clearance cost
+  // On squared offsets of control points beyond fidelity_tolerance from the initial curve, which
+  // follows the path: without it, smoothness rounded DEP's many-waypoint paths past
+  // trajectory.max_deviation and they were flown at half speed or on the fallback.
+  double weight_fidelity = 20.0;
+  double fidelity_tolerance = 0.25;  // m
+  int samples_per_segment = 2;       // curve points per knot interval in the clearance cost
 };
 
 struct PathConfig {
