@@ -107,6 +107,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   k.get("yaw_rate", c.cost.yaw_rate, 1e-3, 100.0);
   k.get("yaw_weight", c.cost.yaw_weight, 0.0, 1e6);
   k.get("min_time", c.cost.min_time, 1e-6, 1e6);
+  k.get("turn_while_flying", c.cost.turn_while_flying);
 
   auto l = m.child("loop");
   l.get("goal_tolerance", c.loop.goal_tolerance, 0.0, 100.0);

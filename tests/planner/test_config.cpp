@@ -56,6 +56,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(cost.yaw_rate);
   SAME(cost.yaw_weight);
   SAME(cost.min_time);
+  SAME(cost.turn_while_flying);
   SAME(loop.goal_tolerance);
   SAME(loop.yaw_tolerance);
   SAME(loop.dwell_s);

@@ -51,6 +51,7 @@ TEST(SemanticReward, MalformedRegionsRewardNothing) {
 
 TEST(TravelCost, DistanceOverSpeedPlusWeightedTurn) {
   CostConfig c;
+  c.turn_while_flying = false;  // the paper's Eq. 8
   c.velocity = 2.0;
   c.yaw_rate = 0.5;
   c.yaw_weight = 3.0;
@@ -64,6 +65,23 @@ TEST(TravelCost, DistanceOverSpeedPlusWeightedTurn) {
   EXPECT_DOUBLE_EQ(travel_time(0.0, 0.0, c), 0.1);
 }
 
+TEST(TravelCost, TurningWhileFlyingTakesTheLongerOfTheTwo) {
+  CostConfig c;  // the default
+  ASSERT_TRUE(c.turn_while_flying);
+  c.velocity = 2.0;
+  c.yaw_rate = 0.5;
+  c.yaw_weight = 3.0;
+  c.min_time = 0.1;
+  EXPECT_DOUBLE_EQ(travel_time(4.0, 0.0, c), 2.0);              // the flight alone
+  EXPECT_DOUBLE_EQ(travel_time(4.0, 0.2, c), 2.0);              // a turn shorter than the flight is free
+  EXPECT_DOUBLE_EQ(travel_time(4.0, 1.0, c), 3.0 * 1.0 / 0.5);  // a longer turn sets the time
+  EXPECT_DOUBLE_EQ(travel_time(0.0, 1.0, c), 6.0);              // a turn in place as before
+  EXPECT_DOUBLE_EQ(travel_time(0.0, 0.0, c), 0.1);
+  // So a node that needs a move and a turn no longer loses to one that needs only the move.
+  c.turn_while_flying = false;
+  EXPECT_GT(travel_time(4.0, 0.2, c), travel_time(4.0, 0.0, c));
+}
+
 TEST(TravelCost, WrapAngle) {
   EXPECT_NEAR(wrap_angle(3 * kPi), kPi, 1e-12);
   EXPECT_NEAR(wrap_angle(-kPi), kPi, 1e-12);
@@ -72,16 +90,23 @@ TEST(TravelCost, WrapAngle) {
 }
 
 TEST(Score, OrdersByUtilityOverTime) {
-  const CostConfig c;                                                      // v = 1, ω = 1, w_psi = 1
+  const CostConfig c;  // v = 1, ω = 1, w_psi = 1, turning while flying
   const double near_small = node_score(100, 0, travel_time(2.0, 0.0, c));  // 50
   const double far_big = node_score(300, 0, travel_time(10.0, 0.0, c));    // 30
-  const double near_turn = node_score(100, 0, travel_time(2.0, kPi, c));   // 100 / 5.14
-  const double rewarded = node_score(100, 50, travel_time(2.0, 0.0, c));   // 75
+  const double near_turn = node_score(100, 0, travel_time(2.0, kPi, c));   // 100 / π: the turn takes longer
+  const double near_small_turn = node_score(100, 0, travel_time(2.0, 1.0, c));  // 50: turned on the way
+  const double rewarded = node_score(100, 50, travel_time(2.0, 0.0, c));        // 75
   EXPECT_DOUBLE_EQ(near_small, 50.0);
   EXPECT_GT(near_small, far_big);
-  EXPECT_GT(far_big, near_turn);
+  EXPECT_GT(near_turn, far_big);
+  EXPECT_DOUBLE_EQ(near_small_turn, near_small);
   EXPECT_GT(rewarded, near_small);
-  EXPECT_NEAR(near_turn, 100.0 / (2.0 + kPi), 1e-12);
+  EXPECT_NEAR(near_turn, 100.0 / kPi, 1e-12);
+  // The paper's sum charges the turn on top of the flight.
+  CostConfig sum;
+  sum.turn_while_flying = false;
+  EXPECT_NEAR(node_score(100, 0, travel_time(2.0, kPi, sum)), 100.0 / (2.0 + kPi), 1e-12);
+  EXPECT_GT(far_big, node_score(100, 0, travel_time(2.0, kPi, sum)));
 }
 
 }  // namespace

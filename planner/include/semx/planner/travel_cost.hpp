@@ -1,7 +1,10 @@
 // Travel cost and score of a candidate (paper Eq. 8-9):
-//   T_path = d / v + w_psi · Δψ / ω,   Score = (G + R_sem) / T_path,
+//   T_path = max(d / v, w_psi · Δψ / ω)   (CostConfig::turn_while_flying, the default), or
+//   T_path = d / v + w_psi · Δψ / ω       (the paper's Eq. 8),
+//   Score = (G + R_sem) / T_path,
 // d the length of the roadmap path from the vehicle to the node, Δψ the turn from the vehicle's
-// heading to the node's best yaw (the smaller way round, in [0, π]). T_path is floored at
+// heading to the node's best yaw (the smaller way round, in [0, π]). The controller turns while
+// it flies, so the first form is the time the flight takes. T_path is floored at
 // CostConfig::min_time so that the node under the vehicle cannot score infinitely.
 #pragma once
 
@@ -13,7 +16,9 @@
 namespace semx::planner {
 
 inline double travel_time(double distance, double yaw_change, const CostConfig& c) {
-  const double t = distance / c.velocity + c.yaw_weight * std::abs(yaw_change) / c.yaw_rate;
+  const double fly = distance / c.velocity;
+  const double turn = c.yaw_weight * std::abs(yaw_change) / c.yaw_rate;
+  const double t = c.turn_while_flying ? std::max(fly, turn) : fly + turn;
   return std::max(t, c.min_time);
 }
 
