@@ -115,7 +115,7 @@ struct CostConfig {
   // The controller flies position and heading as one trajectory, so a path that moves and turns
   // takes the longer of d/v and w_psi Δψ/ω, not their sum (the paper's Eq. 8). The sum counts a
   // turn made on the way as time lost and steers DEP toward goals straight ahead; with the
-  // longer of the two, 85 % coverage came 18-20 % earlier in env2 and env3 over ten seeds
+  // longer of the two, 85 % coverage came 18-23 % earlier in env2 and env3 over ten seeds
   // (docs/planner.md, "Travel cost and score"). false: the paper's sum.
   bool turn_while_flying = true;
 };
