@@ -578,13 +578,26 @@ void DepStrategy::hold_heading_through_doorways(const std::vector<int64_t>& path
                                                 std::vector<double>& yaws) const {
   // A 0.5 m square body turned 45° is 0.71 m across: in a 0.9 m doorway it touched a jamb when it
   // crossed 10 cm off the middle while turning (env3, semantic-dep, seed 3). Through a passage
-  // node the vehicle holds the direction of travel from the waypoint before it to the one after,
-  // so the body crosses square to its path.
+  // node the vehicle holds a heading square to the direction of travel from the waypoint before
+  // it to the one after, so the body crosses square to its path. The body is square, so each
+  // quarter turn from that direction will do (as the controller's square headings): the one
+  // that turns the least on the way from the yaw before the hold to the yaw after it. Holding the
+  // direction of travel itself turned a vehicle 265° where 95° reached the goal's yaw (env1, dep,
+  // seed 1, a doorway at 2 s: 128° back to face the doorway, 137° on to the goal's yaw).
+  const double start_yaw = yaws.empty() ? 0.0 : yaws.front();
   for (size_t i = 1; i + 1 < path.size() && i + 1 < w.size(); ++i) {
     if (!graph_.alive(path[i]) || !graph_.node(path[i]).passage) continue;
     const Eigen::Vector3d d = w[i + 1] - w[i - 1];
     if (d.head<2>().norm() < 1e-6) continue;
-    const double heading = std::atan2(d.y(), d.x());
+    const double travel = std::atan2(d.y(), d.x());
+    const double before = i >= 2 ? yaws[i - 2] : start_yaw;
+    const double after = i + 2 < yaws.size() ? yaws[i + 2] : yaws.back();
+    double heading = travel, least = 1e9;
+    for (const int k : {0, 1, -1, 2}) {  // ties go to facing the way it flies
+      const double h = wrap_angle(travel + 0.5 * kPi * k);
+      const double turn = yaw_distance(before, h) + yaw_distance(h, after);
+      if (turn < least - 1e-9) least = turn, heading = h;
+    }
     yaws[i - 1] = yaws[i] = heading;
     if (i + 2 < w.size()) yaws[i + 1] = heading;  // the goal keeps the yaw it was chosen for
   }

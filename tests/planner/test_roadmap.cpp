@@ -385,8 +385,9 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   }
   EXPECT_EQ(approaches, 2);
 
-  // A path through the passage holds the direction of travel there and at the waypoints either
-  // side of it; the goal keeps its own yaw.
+  // A path through the passage holds a heading square to the direction of travel there and at
+  // the waypoints either side of it: the quarter turn that turns the least between the yaws
+  // before and after the hold. The goal keeps its own yaw.
   std::vector<int64_t> near_far;
   for (const RoadmapEdge& e : dep.graph().node(passage).edges) {
     if (std::abs(dep.graph().node(e.to).position.x() - dep.graph().node(passage).position.x()) < 1e-9)
@@ -399,10 +400,20 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   std::vector<Eigen::Vector3d> w;
   for (int64_t id : path) w.push_back(dep.graph().node(id).position);
   w.back() += Eigen::Vector3d(1.0, 1.0, 0.0);  // a goal beyond, off the line
-  std::vector<double> yaws = interpolate_yaws(w, 0.0, 1.0);
-  dep.hold_heading_through_doorways(path, w, yaws);
-  for (size_t i = 1; i <= 3; ++i) EXPECT_NEAR(yaws[i], kPi / 2, 1e-9) << i;  // +y, through the door
-  EXPECT_NEAR(yaws.back(), 1.0, 1e-9);
+  const auto held = [&](double start_yaw, double goal_yaw) {
+    std::vector<double> yaws = interpolate_yaws(w, start_yaw, goal_yaw);
+    dep.hold_heading_through_doorways(path, w, yaws);
+    EXPECT_NEAR(yaws.back(), goal_yaw, 1e-9);
+    EXPECT_NEAR(yaws[1], yaws[2], 1e-9);
+    EXPECT_NEAR(yaws[3], yaws[2], 1e-9);
+    return yaws[2];
+  };
+  // Travel is +y. Facing it from 1.3 to 1.8 rad: through the door facing the way it flies.
+  EXPECT_NEAR(held(1.3, 1.8), kPi / 2, 1e-9);
+  // From 0 to 1: facing +y would turn 1.57 + 0.57 rad; facing +x, sideways, 0 + 1.
+  EXPECT_NEAR(held(0.0, 1.0), 0.0, 1e-9);
+  // From 2.1 to -2.9 rad (1.28 rad the short way, through pi): facing -x, on the way.
+  EXPECT_NEAR(std::abs(held(2.1, -2.9)), kPi, 1e-9);
 }
 
 // Sets a wall across the corridor at x = 3 occupied; returns its changes (free -> occupied).
