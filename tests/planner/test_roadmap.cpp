@@ -13,6 +13,7 @@
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/roadmap.hpp"
+#include "semx/planner/travel_cost.hpp"
 
 namespace semx::planner {
 namespace {
@@ -385,9 +386,8 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   }
   EXPECT_EQ(approaches, 2);
 
-  // A path through the passage holds a heading square to the direction of travel there and at
-  // the waypoints either side of it: the quarter turn that turns the least between the yaws
-  // before and after the hold. The goal keeps its own yaw.
+  // A path through the passage holds the direction of travel there and at the waypoints either
+  // side of it; the goal keeps its own yaw.
   std::vector<int64_t> near_far;
   for (const RoadmapEdge& e : dep.graph().node(passage).edges) {
     if (std::abs(dep.graph().node(e.to).position.x() - dep.graph().node(passage).position.x()) < 1e-9)
@@ -400,20 +400,46 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   std::vector<Eigen::Vector3d> w;
   for (int64_t id : path) w.push_back(dep.graph().node(id).position);
   w.back() += Eigen::Vector3d(1.0, 1.0, 0.0);  // a goal beyond, off the line
-  const auto held = [&](double start_yaw, double goal_yaw) {
-    std::vector<double> yaws = interpolate_yaws(w, start_yaw, goal_yaw);
-    dep.hold_heading_through_doorways(path, w, yaws);
-    EXPECT_NEAR(yaws.back(), goal_yaw, 1e-9);
-    EXPECT_NEAR(yaws[1], yaws[2], 1e-9);
-    EXPECT_NEAR(yaws[3], yaws[2], 1e-9);
-    return yaws[2];
-  };
-  // Travel is +y. Facing it from 1.3 to 1.8 rad: through the door facing the way it flies.
-  EXPECT_NEAR(held(1.3, 1.8), kPi / 2, 1e-9);
-  // From 0 to 1: facing +y would turn 1.57 + 0.57 rad; facing +x, sideways, 0 + 1.
-  EXPECT_NEAR(held(0.0, 1.0), 0.0, 1e-9);
-  // From 2.1 to -2.9 rad (1.28 rad the short way, through pi): facing -x, on the way.
-  EXPECT_NEAR(std::abs(held(2.1, -2.9)), kPi, 1e-9);
+  std::vector<double> yaws = interpolate_yaws(w, 0.0, 1.0);
+  dep.hold_heading_through_doorways(path, w, yaws);
+  for (size_t i = 1; i <= 3; ++i) EXPECT_NEAR(yaws[i], kPi / 2, 1e-9) << i;  // +y, through the door
+  EXPECT_NEAR(yaws.back(), 1.0, 1e-9);
+}
+
+// A goal across a doorway is charged the turn its path flies: to the heading held through the
+// doorway and on to the goal's yaw, not the direct turn to the goal's yaw (env1, dep, seed 1: a
+// goal scored with 95° was flown with 265°).
+TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
+  DepFixture f;
+  two_rooms_with_doorway(f.grid, 3.15, 3.95);  // 0.9 m free: its middle takes passage nodes only
+  fill_m(f.grid, {5.05, 4.15, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kUnknown);  // the far room's +x end
+  f.frontiers.reset(f.grid);
+  // The paper's summed travel time, in which every radian of turn costs (with the longer of
+  // flight and turn, a goal 3 m away hides a turn of up to 3 rad).
+  f.config.cost.turn_while_flying = false;
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  int goals = 0;
+  for (int64_t cycle = 1; cycle <= 60; ++cycle) {
+    // Facing +x, as the views into the far room's unknown end: the direct turn is small, the
+    // path through the doorway turns to +y and back.
+    PlanContext ctx = f.context({3.55, 2.0, 1.2}, 0.1, cycle);
+    const PlanOutcome o = dep.plan(ctx);
+    if (!o.goal.valid) continue;
+    ++goals;
+    double turn = 0.0;
+    for (size_t i = 1; i < o.goal.yaws.size(); ++i) turn += yaw_distance(o.goal.yaws[i - 1], o.goal.yaws[i]);
+    turn += yaw_distance(ctx.pose.yaw, o.goal.yaws.front());
+    // The cost is the travel time of the turn flown (charged the direct turn, the goals through
+    // the doorway of this room scored above those that do not turn back and won).
+    const double distance = o.goal.waypoints.size() > 1 ? [&] {
+      double d = 0.0;
+      for (size_t i = 1; i < o.goal.waypoints.size(); ++i) d += (o.goal.waypoints[i] - o.goal.waypoints[i - 1]).norm();
+      return d;
+    }() : 0.0;
+    EXPECT_NEAR(o.goal.cost, travel_time(distance, turn, f.config.cost), 1e-6) << cycle;
+  }
+  EXPECT_GT(goals, 0);
 }
 
 // Sets a wall across the corridor at x = 3 occupied; returns its changes (free -> occupied).

@@ -70,8 +70,8 @@ class DepStrategy : public Strategy {
   // side of its doorway, on the line straight through it; returns the passage node's id or -1.
   int64_t add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, int64_t id);
   // Sets the yaws at each passage node of a path and at the waypoints either side of it to the
-  // quarter turn from the direction of travel through it that turns the vehicle the least.
-  void hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
+  // direction of travel through it; true when it held any.
+  bool hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
                                      std::vector<double>& yaws) const;
   // Step 3: up to sampling.samples new nodes from draws around the vehicle and the frontier
   // clusters (`frontier_fraction` of them around clusters; `attempts_scale` x the checks).
