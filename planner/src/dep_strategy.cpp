@@ -446,7 +446,9 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
       for (int64_t p : path) w.push_back(graph_.node(p).position);
       std::vector<double> yaws = interpolate_yaws(w, ctx.pose.yaw, n.gain.yaw);
       if (hold_heading_through_doorways(path, w, yaws)) {
-        double turn = 0.0;
+        // From the vehicle's yaw: the first waypoint (the vehicle) holds one too when the doorway
+        // is the next.
+        double turn = yaw_distance(ctx.pose.yaw, yaws.front());
         for (size_t i = 1; i < yaws.size(); ++i) turn += yaw_distance(yaws[i - 1], yaws[i]);
         const size_t i = static_cast<size_t>(id);
         const double flown = score(n.gain.gain, reward_[i], search_.distance[i], turn);
