@@ -397,6 +397,15 @@ bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id) const {
          yaw_distance(ctx.pose.yaw, n.gain.yaw) < config_.loop.yaw_tolerance;
 }
 
+DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t id) const {
+  FlownPath f;
+  const std::vector<int64_t> path = Roadmap::path_to(search_, id);
+  for (int64_t p : path) f.waypoints.push_back(graph_.node(p).position);
+  f.yaws = interpolate_yaws(f.waypoints, ctx.pose.yaw, graph_.node(id).gain.yaw);
+  f.held = hold_heading_through_doorways(path, f.waypoints, f.yaws);
+  return f;
+}
+
 Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
                               int64_t* unreachable) {
   {
@@ -441,15 +450,12 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     RoadmapNode& n = graph_.node(id);
     if (!n.gain_stale && !turn_checked.count(id)) {
       turn_checked.insert(id);
-      const std::vector<int64_t> path = Roadmap::path_to(search_, id);
-      std::vector<Eigen::Vector3d> w;
-      for (int64_t p : path) w.push_back(graph_.node(p).position);
-      std::vector<double> yaws = interpolate_yaws(w, ctx.pose.yaw, n.gain.yaw);
-      if (hold_heading_through_doorways(path, w, yaws)) {
+      const FlownPath f = flown_path(ctx, id);
+      if (f.held) {
         // From the vehicle's yaw: the first waypoint (the vehicle) holds one too when the doorway
         // is the next.
-        double turn = yaw_distance(ctx.pose.yaw, yaws.front());
-        for (size_t i = 1; i < yaws.size(); ++i) turn += yaw_distance(yaws[i - 1], yaws[i]);
+        double turn = yaw_distance(ctx.pose.yaw, f.yaws.front());
+        for (size_t i = 1; i < f.yaws.size(); ++i) turn += yaw_distance(f.yaws[i - 1], f.yaws[i]);
         const size_t i = static_cast<size_t>(id);
         const double flown = score(n.gain.gain, reward_[i], search_.distance[i], turn);
         if (flown < score_[i] - 1e-9) {
@@ -477,10 +483,9 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     goal.reward = reward_[static_cast<size_t>(id)];
     goal.cost = cost_[static_cast<size_t>(id)];
     goal.score = score_[static_cast<size_t>(id)];
-    const std::vector<int64_t> path = Roadmap::path_to(search_, id);
-    for (int64_t p : path) goal.waypoints.push_back(graph_.node(p).position);
-    goal.yaws = interpolate_yaws(goal.waypoints, ctx.pose.yaw, goal.yaw);
-    hold_heading_through_doorways(path, goal.waypoints, goal.yaws);
+    FlownPath f = flown_path(ctx, id);
+    goal.waypoints = std::move(f.waypoints);
+    goal.yaws = std::move(f.yaws);
     break;
   }
   int64_t cut_off = 0;

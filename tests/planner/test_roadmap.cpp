@@ -422,8 +422,8 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
   int goals = 0;
   for (int64_t cycle = 1; cycle <= 60; ++cycle) {
     // Facing +x, as the views into the far room's unknown end: the direct turn is small, the
-    // path through the doorway turns to +y and back.
-    // Half the cycles next to the doorway, where the vehicle's own waypoint holds the heading.
+    // path through the doorway turns to +y and back. Half the cycles next to the doorway, where
+    // the vehicle's own waypoint holds the heading.
     PlanContext ctx = f.context({3.55, cycle % 2 ? 2.0 : 3.3, 1.2}, 0.1, cycle);
     const PlanOutcome o = dep.plan(ctx);
     if (!o.goal.valid) continue;
