@@ -386,9 +386,35 @@ void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
 
 double DepStrategy::score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const {
   const RoadmapNode& n = graph_.node(id);
-  const double reward = semantic_ && ctx.regions ? semantic_reward(n.position, *ctx.regions) : 0.0;
+  const double reward = reward_at(ctx, n.position);
   return score(n.gain.gain, reward, search_.distance[static_cast<size_t>(id)],
                yaw_distance(ctx.pose.yaw, n.gain.yaw));
+}
+
+double DepStrategy::reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const {
+  if (!semantic_ || !ctx.regions) return 0.0;
+  return semantic_reward(p, *ctx.regions, &region_factor_);
+}
+
+void DepStrategy::update_region_factors(PlanContext& ctx) {
+  region_factor_.clear();
+  const double kappa = config_.reward.unexplored_weight;
+  if (!semantic_ || !ctx.regions || !(kappa > 0)) return;
+  region_factor_.assign(ctx.regions->size(), 1.0);
+  for (size_t i = 0; i < ctx.regions->size(); ++i) {
+    const SemanticRegion& s = (*ctx.regions)[i];
+    if (!s.active || !(s.radius > 0) || !std::isfinite(s.radius) || !s.centroid.allFinite()) continue;
+    // The node nearest the centroid stands for the object's surroundings: a centroid lies inside
+    // the object, where rays start in occupied or unknown voxels, and a node is known free. Its
+    // cached gain is reused (stale is re-evaluated, once per region at most).
+    const std::vector<int64_t> near = graph_.nearest(s.centroid, 1, std::min(s.radius, 2.5));
+    if (near.empty()) continue;
+    RoadmapNode& n = graph_.node(near.front());
+    if (!n.gain.valid || n.gain_stale) evaluate_gain(ctx, n.id);
+    double all_round = 0.0;
+    for (float b : n.gain.bin_gain) all_round += b;
+    region_factor_[i] = 1.0 + kappa * all_round;
+  }
 }
 
 bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id) const {
@@ -414,6 +440,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ctx.counters->search_settled += search_.settled;
     ctx.counters->search_ms += w.ms();
   }
+  update_region_factors(ctx);
   const size_t slots = graph_.slots().size();
   reward_.assign(slots, 0.0);
   cost_.assign(slots, -1.0);
@@ -428,7 +455,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ++reachable;
     if (!n.gain.valid) evaluate_gain(ctx, n.id);
     const RoadmapNode& m = graph_.node(n.id);
-    const double reward = semantic_ && ctx.regions ? semantic_reward(m.position, *ctx.regions) : 0.0;
+    const double reward = reward_at(ctx, m.position);
     reward_[static_cast<size_t>(n.id)] = reward;
     cost_[static_cast<size_t>(n.id)] =
         travel_time(search_.distance[static_cast<size_t>(n.id)], ctx.pose.yaw, m.gain.yaw, config_.cost);
@@ -561,7 +588,7 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   RoadmapNode& n = graph_.node(goal.node);
   if (n.gain_stale || !n.gain.valid) evaluate_gain(ctx, goal.node);
   if (n.gain.gain < config_.gain.min_gain) return std::nullopt;
-  const double reward = semantic_ && ctx.regions ? semantic_reward(n.position, *ctx.regions) : 0.0;
+  const double reward = reward_at(ctx, n.position);
   // The goal keeps the yaw it was chosen with (its best yaw may have moved since).
   const double g = gains_.gain_at_yaw(n.gain, goal.yaw);
   return node_score(

@@ -109,6 +109,9 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   k.get("min_time", c.cost.min_time, 1e-6, 1e6);
   k.get("turn_while_flying", c.cost.turn_while_flying);
 
+  auto rw = m.child("reward");
+  rw.get("unexplored_weight", c.reward.unexplored_weight, 0.0, 1e3);
+
   auto l = m.child("loop");
   l.get("goal_tolerance", c.loop.goal_tolerance, 0.0, 100.0);
   l.get("yaw_tolerance", c.loop.yaw_tolerance, 0.0, 7.0);

@@ -14,9 +14,14 @@ double region_reward(const Eigen::Vector3d& p, const SemanticRegion& s) {
   return s.weight * (1.0 - d / s.radius);
 }
 
-double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions) {
+double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                       const std::vector<double>* factors) {
+  const bool scaled = factors && factors->size() == regions.size();
   double r = 0.0;
-  for (const SemanticRegion& s : regions) r += region_reward(p, s);
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const double ri = region_reward(p, regions[i]);
+    if (ri > 0) r += scaled ? ri * (*factors)[i] : ri;
+  }
   return r;
 }
 

@@ -57,6 +57,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(cost.yaw_weight);
   SAME(cost.min_time);
   SAME(cost.turn_while_flying);
+  SAME(reward.unexplored_weight);
   SAME(loop.goal_tolerance);
   SAME(loop.yaw_tolerance);
   SAME(loop.dwell_s);
@@ -106,12 +107,21 @@ TEST(PlannerConfig, DefaultsMatchThePaperAndTheController) {
   EXPECT_EQ(d.kind(), PlannerKind::kSemanticDep);
 }
 
+TEST(PlannerConfig, TheShippedAblationsLoad) {
+  const std::string dir = std::string(SEMX_SOURCE_DIR) + "/planner/config/ablations/";
+  EXPECT_FALSE(load_config<PlannerConfig>(dir + "paper_travel_cost.yaml").cost.turn_while_flying);
+  EXPECT_EQ(load_config<PlannerConfig>(dir + "unexplored_weight_0.001.yaml").reward.unexplored_weight, 0.001);
+  EXPECT_EQ(load_config<PlannerConfig>(dir + "unexplored_weight_0.003.yaml").reward.unexplored_weight, 0.003);
+}
+
 TEST(PlannerConfig, OverridesAndErrors) {
   const auto c =
       load_config<PlannerConfig>("", {"planner=aep", "sampling.samples=30", "gain.weight_surface=8"});
   EXPECT_EQ(c.kind(), PlannerKind::kAep);
   EXPECT_EQ(c.sampling.samples, 30);
   EXPECT_EQ(c.gain.weight_surface, 8.0);
+  EXPECT_EQ(load_config<PlannerConfig>("", {"reward.unexplored_weight=0.002"}).reward.unexplored_weight, 0.002);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"reward.unexplored_weight=-1"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"planner=rrt"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.sample=30"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.samples=0"}), ConfigError);

@@ -143,6 +143,55 @@ TEST(Planner, PicksTheSemanticallyRewardedOfTwoEqualNodes) {
   EXPECT_EQ(g.position, plain.position);
 }
 
+// reward.unexplored_weight κ: a region's reward is multiplied by 1 + κ U, U the all-round gain of
+// the roadmap node nearest its centroid; a region in mapped surroundings keeps the paper's reward.
+TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
+  auto reward_of = [](MirrorScene& s, int64_t id) {
+    for (const RoadmapView::Node& n : s.dep.roadmap(nullptr).nodes)
+      if (n.id == id) return n.reward;
+    ADD_FAILURE() << "node " << id << " not in the roadmap";
+    return -1.0;
+  };
+  SemanticRegion r;
+  r.centroid = Eigen::Vector3d(3.6, 2.05, 1.25);  // 0.45 m from the left node, nearest to it
+  r.weight = 100.0;
+  r.radius = 1.5;
+  const double paper = 100.0 * (1.0 - 0.45 / 1.5);
+
+  MirrorScene plain;
+  plain.regions = {r};
+  plain.choose();
+  ASSERT_GE(plain.left, 0);
+  EXPECT_NEAR(reward_of(plain, plain.left), paper, 1e-9);
+
+  MirrorScene scaled;
+  scaled.config.reward.unexplored_weight = 1e-3;
+  scaled.dep = DepStrategy(scaled.config, true);
+  scaled.dep.on_map_reset();
+  scaled.regions = {r};
+  scaled.choose();
+  ASSERT_GE(scaled.left, 0);
+  double all_round = 0.0;
+  for (float b : scaled.dep.graph().node(scaled.left).gain.bin_gain) all_round += b;
+  ASSERT_GT(all_round, scaled.dep.graph().node(scaled.left).gain.gain);  // more than one window
+  EXPECT_NEAR(reward_of(scaled, scaled.left), paper * (1.0 + 1e-3 * all_round), 1e-6 * paper);
+  EXPECT_NEAR(reward_of(scaled, scaled.right), 0.0, 1e-12);  // out of the region's reach
+
+  // Mapped all round: the nearest node sees nothing unknown, and the reward is the paper's.
+  MirrorScene known;
+  known.grid = mapper::StateGrid(0.1);
+  SyntheticWorld::room({12, 4, 2.5}, {6, 2, 1.2})
+      .reveal(known.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(12.2, 4.2, 2.7)});
+  known.frontiers.reset(known.grid);
+  known.config.reward.unexplored_weight = 1e-3;
+  known.dep = DepStrategy(known.config, true);
+  known.dep.on_map_reset();
+  known.regions = {r};
+  known.choose();
+  ASSERT_GE(known.left, 0);
+  EXPECT_NEAR(reward_of(known, known.left), paper, 1e-9);
+}
+
 TEST(Planner, DeclaresDoneOnAFullyKnownMap) {
   const SyntheticWorld w = SyntheticWorld::two_rooms();
   mapper::StateGrid g = w.full_map();

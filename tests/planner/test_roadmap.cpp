@@ -412,18 +412,23 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
 TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
   DepFixture f;
   two_rooms_with_doorway(f.grid, 3.15, 3.95);  // 0.9 m free: its middle takes passage nodes only
-  fill_m(f.grid, {5.05, 4.15, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kUnknown);  // the far room's +x end
+  // A 0.7 m deep wall: no edge between ordinary nodes spans the doorway, every crossing goes
+  // through a passage node and holds the heading there.
+  fill_m(f.grid, {0.05, 3.65, 0.05}, {3.05, 4.35, 2.45}, VoxelState::kOccupied);
+  fill_m(f.grid, {4.05, 3.65, 0.05}, {7.95, 4.35, 2.45}, VoxelState::kOccupied);
+  fill_m(f.grid, {5.05, 4.45, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kUnknown);  // the far room's +x end
   f.frontiers.reset(f.grid);
   // The paper's summed travel time, in which every radian of turn costs (with the longer of
   // flight and turn, a goal 3 m away hides a turn of up to 3 rad).
   f.config.cost.turn_while_flying = false;
   DepStrategy dep(f.config, false);
   dep.on_map_reset();
-  int goals = 0;
+  int goals = 0, held = 0, held_at_vehicle = 0;
   for (int64_t cycle = 1; cycle <= 60; ++cycle) {
     // Facing +x, as the views into the far room's unknown end: the direct turn is small, the
-    // path through the doorway turns to +y and back. Half the cycles next to the doorway, where
-    // the vehicle's own waypoint holds the heading.
+    // path through the doorway turns to +y and back. Two places before the wall; from the
+    // farther one the root's edge goes straight to the passage node, so the vehicle's own
+    // waypoint holds the heading.
     PlanContext ctx = f.context({3.55, cycle % 2 ? 2.0 : 3.3, 1.2}, 0.1, cycle);
     const PlanOutcome o = dep.plan(ctx);
     if (!o.goal.valid) continue;
@@ -439,8 +444,14 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
       return d;
     }() : 0.0;
     EXPECT_NEAR(o.goal.cost, travel_time(distance, turn, f.config.cost), 1e-6) << cycle;
+    // Goals whose path turns more than the direct turn (a held heading), some of them from the
+    // vehicle's own waypoint (the turn 72da60a added): what this test is about.
+    held += turn > yaw_distance(ctx.pose.yaw, o.goal.yaw) + 0.5;
+    held_at_vehicle += yaw_distance(ctx.pose.yaw, o.goal.yaws.front()) > 0.5;
   }
   EXPECT_GT(goals, 0);
+  EXPECT_GT(held, 0);
+  EXPECT_GT(held_at_vehicle, 0);
 }
 
 // Sets a wall across the corridor at x = 3 occupied; returns its changes (free -> occupied).

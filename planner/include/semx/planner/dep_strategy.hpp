@@ -109,6 +109,10 @@ class DepStrategy : public Strategy {
 
  private:
   double score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const;
+  // R_sem at p with this cycle's region factors (0 for plain DEP).
+  double reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const;
+  // Each region's 1 + κ U_i (config reward.unexplored_weight), for this cycle's regions.
+  void update_region_factors(PlanContext& ctx);
   // Some voxel of obstacle_voxels_ has its centre within `radius` of the segment a-b.
   bool obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double res) const;
   bool nothing_to_do(PlanContext& ctx, int64_t id) const;
@@ -128,6 +132,7 @@ class DepStrategy : public Strategy {
   // The last cycle's search and per-slot values, for goal_score() and the roadmap view.
   Roadmap::Search search_;
   std::vector<double> reward_, cost_, score_;
+  std::vector<double> region_factor_;  // one per region of ctx.regions this cycle
 };
 
 }  // namespace semx::planner

@@ -120,6 +120,16 @@ struct CostConfig {
   bool turn_while_flying = true;
 };
 
+// The semantic reward R_sem (semantic_reward.hpp); only semantic-dep uses it.
+struct RewardConfig {
+  // κ, per weighted voxel: region i rewards w_i (1 - d_i / r_i) (1 + κ U_i), where U_i is the
+  // gain over every yaw (weighted unknown voxels in view all round) of the roadmap node nearest
+  // its centroid. An object whose surroundings are still unexplored marks a room not yet seen
+  // and draws the vehicle there; one in a mapped room rewards what the paper's Eq. 6 gives.
+  // 0: the paper's reward.
+  double unexplored_weight = 0.0;
+};
+
 // The main loop: when to replan, when to give up.
 struct LoopConfig {
   double goal_tolerance = 0.3;  // m, the goal counts as reached within this
@@ -184,6 +194,7 @@ struct PlannerConfig {
   RoadmapConfig roadmap;
   GainConfig gain;
   CostConfig cost;
+  RewardConfig reward;
   LoopConfig loop;
   ChargeConfig charge;
   NbvConfig nbv;

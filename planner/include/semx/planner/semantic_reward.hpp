@@ -23,7 +23,8 @@ struct SemanticRegion {
 
 // R_i(n) of one region.
 double region_reward(const Eigen::Vector3d& p, const SemanticRegion& region);
-// R_sem(n).
-double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions);
+// R_sem(n); `factors`, when given and one per region, multiply each region's R_i.
+double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                       const std::vector<double>* factors = nullptr);
 
 }  // namespace semx::planner
