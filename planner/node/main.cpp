@@ -33,6 +33,15 @@ int main(int argc, char** argv) {
     install_shutdown_handlers();
     std::cout << "semx-planner: " << config.planner << ", " << config.sampling.samples << " samples, seed "
               << config.seed << " on " << node.node().url() << "\n";
-    return node.run();
+    const int rc = node.run();
+    // What a run that does not reproduce needs first: a map gap or a resync means lost messages.
+    const auto& n = node.node().counters();
+    const auto& m = node.map().counters();
+    const int64_t gaps = node.map().has_mirror() ? node.map().mirror().counters().gaps : 0;
+    std::cout << "semx-planner: " << node.planner().iteration() << " cycles, " << node.planner().plan_id()
+              << " plans; map: " << m.updates << " updates, " << m.snapshots << " snapshots, " << m.requests
+              << " requests, " << gaps << " gaps; " << n.received << " messages received, " << n.malformed
+              << " malformed, " << n.dropped << " dropped\n";
+    return rc;
   });
 }
