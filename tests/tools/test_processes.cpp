@@ -7,6 +7,7 @@
 #include <semx/clock_t.hpp>
 #include <semx/node_status_t.hpp>
 
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <regex>
@@ -14,6 +15,7 @@
 #include <sstream>
 
 #include "process_harness.hpp"
+#include "semx/runtime/lcm_url.hpp"
 #include "semx/runtime/node.hpp"
 
 using namespace semx::testing;
@@ -184,6 +186,30 @@ TEST(Processes, HiddenOutputGoesToTheLogAndShowsWhenItFails) {
   EXPECT_NE(read_file(dir + "/chatty.log").find("secret-line"), std::string::npos);
   EXPECT_NE(read_file(dir + "/quiet.log").find("hidden-ok"), std::string::npos);
   EXPECT_NE(read_file(dir + "/shown.log").find("visible-line"), std::string::npos);
+}
+
+// Children get the URL the semx processes resolve, also when none was given: lcm-logger, which
+// is not a semx process, took LCM's own default before, whose ~200 KB receive buffer dropped
+// half of an env3 run's depth images from the log.
+TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
+  const std::string set = temp_path("url.yaml");
+  std::ofstream(set) << "name: url\nprocesses:\n"
+                        "  - name: child\n    command: [/bin/sh, -c, \"echo url=$LCM_DEFAULT_URL.\"]\n";
+  const char* saved = std::getenv("LCM_DEFAULT_URL");
+  const std::string keep = saved ? saved : "";
+  unsetenv("LCM_DEFAULT_URL");
+  const std::string out = temp_path("url.out");
+  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  EXPECT_EQ(launcher.wait(20), 0);
+  EXPECT_NE(read_file(out).find(std::string("url=") + semx::runtime::kDefaultLcmUrl + "."), std::string::npos)
+      << read_file(out);
+  // $LCM_DEFAULT_URL, when set, is what they get.
+  setenv("LCM_DEFAULT_URL", "udpm://239.255.76.67:7999?ttl=0", 1);
+  const std::string out2 = temp_path("url2.out");
+  Process launcher2({bin("semx-launch"), set, "--no-color"}, out2);
+  EXPECT_EQ(launcher2.wait(20), 0);
+  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0."), std::string::npos) << read_file(out2);
+  if (saved) setenv("LCM_DEFAULT_URL", keep.c_str(), 1); else unsetenv("LCM_DEFAULT_URL");
 }
 
 TEST(Processes, MissingProgramAndBadSetAreClearErrors) {

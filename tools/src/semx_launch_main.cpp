@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/lcm_url.hpp"
 #include "semx/tools/launch_set.hpp"
 #include "semx/tools/supervisor.hpp"
 
@@ -75,7 +76,10 @@ int main(int argc, char** argv) {
     SupervisorOptions o;
     o.bin_dir = executable_dir();
     o.root_dir = root;
-    o.lcm_url = lcm_url;
+    // Always exported: a child that is not a semx process (lcm-logger) would otherwise take LCM's
+    // own default, whose ~200 KB receive buffer dropped half of the depth images and nearly every
+    // ESDF_LOCAL of an env3 log (and some MAP_UPDATEs and SIM_CLOCKs of every demo log).
+    o.lcm_url = semx::runtime::resolve_lcm_url(lcm_url);
     o.duration_s = duration;
     o.grace_s = grace;
     o.log_dir = log_dir;
