@@ -120,7 +120,8 @@ TEST(PlannerConfig, OverridesAndErrors) {
   EXPECT_EQ(c.kind(), PlannerKind::kAep);
   EXPECT_EQ(c.sampling.samples, 30);
   EXPECT_EQ(c.gain.weight_surface, 8.0);
-  EXPECT_EQ(load_config<PlannerConfig>("", {"reward.unexplored_weight=0.002"}).reward.unexplored_weight, 0.002);
+  EXPECT_EQ(load_config<PlannerConfig>("", {"reward.unexplored_weight=0.002"}).reward.unexplored_weight,
+            0.002);
   EXPECT_THROW(load_config<PlannerConfig>("", {"reward.unexplored_weight=-1"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"planner=rrt"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.sample=30"}), ConfigError);

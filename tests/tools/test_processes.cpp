@@ -208,8 +208,12 @@ TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
   const std::string out2 = temp_path("url2.out");
   Process launcher2({bin("semx-launch"), set, "--no-color"}, out2);
   EXPECT_EQ(launcher2.wait(20), 0);
-  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0."), std::string::npos) << read_file(out2);
-  if (saved) setenv("LCM_DEFAULT_URL", keep.c_str(), 1); else unsetenv("LCM_DEFAULT_URL");
+  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0."), std::string::npos)
+      << read_file(out2);
+  if (saved)
+    setenv("LCM_DEFAULT_URL", keep.c_str(), 1);
+  else
+    unsetenv("LCM_DEFAULT_URL");
 }
 
 TEST(Processes, MissingProgramAndBadSetAreClearErrors) {
