@@ -22,6 +22,7 @@ struct LiveRun {
   std::vector<std::string> written;
   int64_t map_resets = 0;
   runtime::NodeState state = runtime::NodeState::kStarting;
+  int64_t map_gaps = 0;  // what the evaluator's end-of-run warning reports
 };
 
 LiveRun run_live(const std::string& name, const test::SceneOptions& so, bool lockstep,
@@ -50,7 +51,9 @@ LiveRun run_live(const std::string& name, const test::SceneOptions& so, bool loc
     node.drain();
   }
   if (!ev.finished()) ev.finish(Termination::kStopped);
-  return {ev.evaluation().summary(), eo.out_dir, ev.written(), ev.evaluation().map_resets(), node.state()};
+  const int64_t gaps = ev.map().has_mirror() ? ev.map().mirror().counters().gaps : 0;
+  return {ev.evaluation().summary(),    eo.out_dir,   ev.written(),
+          ev.evaluation().map_resets(), node.state(), gaps};
 }
 
 // Time_r expected from the sweep: the first delta (0.25 s + 0.5 s k) with coverage >= 85 %,
@@ -117,6 +120,8 @@ TEST_F(EvaluatorNodeTest, LockstepRunEndsAtThePlannersDoneWithTheFolderComplete)
 TEST_F(EvaluatorNodeTest, ImmediateApplyGivesTheSameFigures) {
   const LiveRun a = run_live("lock", {}, true);
   const LiveRun b = run_live("rt", {}, false);
+  EXPECT_EQ(a.map_gaps, 0);
+  EXPECT_EQ(b.map_gaps, 0);
   EXPECT_EQ(a.summary.covered_voxels, b.summary.covered_voxels);
   EXPECT_EQ(a.summary.time_r_s, b.summary.time_r_s);
   EXPECT_DOUBLE_EQ(a.summary.time_f_s, b.summary.time_f_s);
@@ -153,6 +158,7 @@ TEST_F(EvaluatorNodeTest, RecoversFromALostDeltaThroughASnapshot) {
   so.snapshot_after_seq = 6;
   const LiveRun r = run_live("gap", so, true);
   EXPECT_GE(r.map_resets, 1);
+  EXPECT_EQ(r.map_gaps, 1);
   EXPECT_EQ(r.summary.covered_voxels, covered_[11]);
   EXPECT_EQ(r.summary.map_seq, 11);
 }

@@ -184,6 +184,15 @@ void EvaluatorNode::finish_at(Termination why, int64_t utime) {
     if (!written_.empty()) {
       std::printf("semx-evaluator: run folder %s\n", options_.out_dir.c_str());
     }
+    // Lost MAP_UPDATEs: the mirror waited for snapshots, so the coverage curve has steps another
+    // run of the seed would not have.
+    const int64_t gaps = map_.has_mirror() ? map_.mirror().counters().gaps : 0;
+    if (gaps > 0) {
+      std::printf(
+          "semx-evaluator: warning: %lld gaps in the MAP_UPDATE sequence (lost messages; "
+          "the map was resynchronised from snapshots): this run may not reproduce\n",
+          static_cast<long long>(gaps));
+    }
     std::fflush(stdout);
   }
   char detail[160];
