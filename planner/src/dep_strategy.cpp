@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <queue>
 #include <sstream>
 #include <utility>
@@ -475,14 +476,15 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     const int64_t id = -queue.top().second;
     queue.pop();
     RoadmapNode& n = graph_.node(id);
+    std::optional<FlownPath> f;  // the winner's path, when the turn check built it
     if (!n.gain_stale && !turn_checked.count(id)) {
       turn_checked.insert(id);
-      const FlownPath f = flown_path(ctx, id);
-      if (f.held) {
+      f = flown_path(ctx, id);
+      if (f->held) {
         // From the vehicle's yaw: the first waypoint (the vehicle) holds one too when the doorway
         // is the next.
-        double turn = yaw_distance(ctx.pose.yaw, f.yaws.front());
-        for (size_t i = 1; i < f.yaws.size(); ++i) turn += yaw_distance(f.yaws[i - 1], f.yaws[i]);
+        double turn = yaw_distance(ctx.pose.yaw, f->yaws.front());
+        for (size_t i = 1; i < f->yaws.size(); ++i) turn += yaw_distance(f->yaws[i - 1], f->yaws[i]);
         const size_t i = static_cast<size_t>(id);
         const double flown = score(n.gain.gain, reward_[i], search_.distance[i], turn);
         if (flown < score_[i] - 1e-9) {
@@ -510,9 +512,9 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     goal.reward = reward_[static_cast<size_t>(id)];
     goal.cost = cost_[static_cast<size_t>(id)];
     goal.score = score_[static_cast<size_t>(id)];
-    FlownPath f = flown_path(ctx, id);
-    goal.waypoints = std::move(f.waypoints);
-    goal.yaws = std::move(f.yaws);
+    if (!f) f = flown_path(ctx, id);
+    goal.waypoints = std::move(f->waypoints);
+    goal.yaws = std::move(f->yaws);
     break;
   }
   int64_t cut_off = 0;

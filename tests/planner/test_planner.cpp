@@ -83,6 +83,11 @@ struct MirrorScene {
     frontiers.reset(grid);
     dep.on_map_reset();
   }
+  // A fresh strategy for the scene's config (after changing it) or plain DEP.
+  void restart(bool semantic = true) {
+    dep = DepStrategy(config, semantic);
+    dep.on_map_reset();
+  }
   Goal choose() {
     PlanContext ctx;
     ctx.grid = &grid;
@@ -131,8 +136,7 @@ TEST(Planner, PicksTheSemanticallyRewardedOfTwoEqualNodes) {
   }
   // Plain DEP ignores the regions.
   MirrorScene v;
-  v.dep = DepStrategy(v.config, false);
-  v.dep.on_map_reset();
+  v.restart(false);
   SemanticRegion r;
   r.centroid = Eigen::Vector3d(plain.node == v.left ? 8.4 : 3.6, 2.05, 1.25);
   r.weight = 1e6;
@@ -166,8 +170,7 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
 
   MirrorScene scaled;
   scaled.config.reward.unexplored_weight = 1e-3;
-  scaled.dep = DepStrategy(scaled.config, true);
-  scaled.dep.on_map_reset();
+  scaled.restart();
   scaled.regions = {r};
   scaled.choose();
   ASSERT_GE(scaled.left, 0);
@@ -184,8 +187,7 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
       .reveal(known.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(12.2, 4.2, 2.7)});
   known.frontiers.reset(known.grid);
   known.config.reward.unexplored_weight = 1e-3;
-  known.dep = DepStrategy(known.config, true);
-  known.dep.on_map_reset();
+  known.restart();
   known.regions = {r};
   known.choose();
   ASSERT_GE(known.left, 0);

@@ -69,8 +69,6 @@ class DepStrategy : public Strategy {
   // A passage node at p (id, or -1 when it connected to nothing yet) and an approach node on each
   // side of its doorway, on the line straight through it; returns the passage node's id or -1.
   int64_t add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, int64_t id);
-  // Sets the yaws at each passage node of a path and at the waypoints either side of it to the
-  // direction of travel through it; true when it held any.
   // The roadmap path to a reached node as the vehicle flies it: waypoints, and yaws turning to
   // the node's best yaw with the doorway holds; `held` when any was held.
   struct FlownPath {
@@ -79,6 +77,8 @@ class DepStrategy : public Strategy {
     bool held = false;
   };
   FlownPath flown_path(const PlanContext& ctx, int64_t id) const;
+  // Sets the yaws at each passage node of a path and at the waypoints either side of it to the
+  // direction of travel through it; true when it held any.
   bool hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
                                      std::vector<double>& yaws) const;
   // Step 3: up to sampling.samples new nodes from draws around the vehicle and the frontier
