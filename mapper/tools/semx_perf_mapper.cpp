@@ -199,6 +199,29 @@ int main(int argc, char** argv) {
   std::vector<double> integrate_ms, integrate_cpu_ms, esdf_ms, esdf_cpu_ms, octo_ms, octo_cpu_ms,
       delta_voxels;
   std::unique_ptr<sm::Mapper> first;
+  // The inside distances by search (the builder's default) against the full transform, with
+  // unknown space as an obstacle (the mapper's default) and as free (what the demo's and the
+  // bench's mapper run for the controller), on each frame's map of the first pass.
+  struct InsideCase {
+    const char* name;
+    bool unknown_as_occupied;
+    double budget;
+    std::vector<double> cpu_ms;
+    std::unique_ptr<sm::EsdfBuilder> builder;
+    int transforms = 0;
+  };
+  InsideCase inside[] = {
+      {"unknown_occupied_search", true, sm::EsdfBuilder::kDefaultSearchBudget, {}, nullptr},
+      {"unknown_occupied_transform", true, 0.0, {}, nullptr},
+      {"unknown_free_search", false, sm::EsdfBuilder::kDefaultSearchBudget, {}, nullptr},
+      {"unknown_free_transform", false, 0.0, {}, nullptr}};
+  for (InsideCase& c : inside) {
+    sm::EsdfParams p = cfg.esdf;
+    p.unknown_as_occupied = c.unknown_as_occupied;
+    c.builder = std::make_unique<sm::EsdfBuilder>(p, cfg.occupancy.resolution);
+    c.builder->set_inside_search_budget(c.budget);
+  }
+  double inside_max_difference = 0.0;
   for (int r = 0; r < runs; ++r) {
     auto mapper = std::make_unique<sm::Mapper>(cfg);
     for (const Frame& f : frames) {
@@ -217,6 +240,18 @@ int main(int argc, char** argv) {
       esdf_ms.push_back(t2.wall_ms - t1.wall_ms);
       esdf_cpu_ms.push_back(t2.cpu_ms - t1.cpu_ms);
       if (r == 0) {
+        for (InsideCase& c : inside) {
+          const Stamp a = Stamp::now();
+          c.builder->update(mapper->map().grid(), f.pose.translation(), sm::KeyBox(), 0, /*force=*/true);
+          c.cpu_ms.push_back(Stamp::now().cpu_ms - a.cpu_ms);
+          c.transforms += c.builder->last_inside_transform();
+        }
+        for (int k = 0; k < 4; k += 2) {
+          const auto& a = inside[k].builder->grid().distance;
+          const auto& b = inside[k + 1].builder->grid().distance;
+          for (size_t i = 0; i < a.size(); ++i)
+            inside_max_difference = std::max(inside_max_difference, std::abs(double(a[i]) - b[i]));
+        }
         delta_voxels.push_back(static_cast<double>(res.delta.changes.size()));
         const octomap::Pointcloud cloud = cloud_of(f);
         const Stamp o0 = Stamp::now();
@@ -265,6 +300,12 @@ int main(int argc, char** argv) {
   line("esdf_update_median", percentile(esdf_ms, 0.5), "ms");
   line("esdf_update_p95", percentile(esdf_ms, 0.95), "ms");
   line("esdf_update_cpu_median", percentile(esdf_cpu_ms, 0.5), "ms");
+  for (const InsideCase& c : inside) {
+    line((std::string("esdf_") + c.name + "_cpu_median").c_str(), percentile(c.cpu_ms, 0.5), "ms");
+  }
+  line("esdf_search_fell_back_frames", static_cast<double>(inside[0].transforms + inside[2].transforms),
+       "frames", 0);
+  line("esdf_search_vs_transform_max_difference", inside_max_difference, "m", 6);
   const sm::EsdfGrid& e = ours.esdf();
   line("esdf_window_voxels", static_cast<double>(e.distance.size()), "voxels", 0);
   line("delta_voxels_median", percentile(delta_voxels, 0.5), "voxels", 0);

@@ -1,6 +1,7 @@
 // The ESDF window against brute force.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
 
 #include "mapper_test_util.hpp"
@@ -62,6 +63,78 @@ TEST(Esdf, MatchesBruteForceOnRandomScenes) {
             ASSERT_NEAR(e.distance[e.index(x, y, z)], brute_distance(g, e, x, y, z), 1e-5)
                 << x << " " << y << " " << z << " unknown_as_occupied " << unknown_as_occupied;
     }
+  }
+}
+
+// Inside obstacles the builder searches around the voxels deeper than one layer, or runs the
+// full transform when they are too many: both against brute force, and against each other.
+TEST(Esdf, InsideThickObstaclesSearchAndTransformMatchBruteForce) {
+  struct Scene {
+    bool unknown_as_occupied;
+    bool random_boxes;      // else a thick slab, a block and an L of bars
+    double budget;          // search visits per window voxel (0: the transform)
+    bool expect_transform;  // what the builder should end up running
+  };
+  // An ample budget searches even the slab; the default one gives way to the transform for the
+  // unknown half, and so does none at all. Random overlapping boxes put the nearest free voxel
+  // off the axes, where a search stopped too early would return a farther one.
+  const double ample = 1e4, none = 0.0, fallback = EsdfBuilder::kDefaultSearchBudget;
+  const Scene scenes[] = {{false, false, ample, false},  {true, false, ample, false},
+                          {true, false, fallback, true}, {false, false, none, true},
+                          {false, true, ample, false},   {false, true, ample, false},
+                          {false, true, ample, false}};
+  std::mt19937 rng(11);
+  for (const Scene& sc : scenes) {
+    EsdfParams p;
+    p.window = {2.0, 1.6, 0.8};
+    // Slab scenes: its deepest voxels are clamped, shallower ones exact.
+    p.max_distance = sc.random_boxes ? 1.0 : 0.35;
+    p.unknown_as_occupied = sc.unknown_as_occupied;
+    EsdfBuilder builder(p, 0.1);
+    builder.set_inside_search_budget(sc.budget);
+    const Eigen::Vector3d center(0.3, -0.45, 1.0);
+    const VoxelKey o = builder.window_origin(center);
+    std::vector<std::array<int, 6>> boxes;
+    std::uniform_int_distribution<int> corner(-3, 17), size(3, 10);
+    for (int b = 0; sc.random_boxes && b < 24; ++b) {
+      const int x = corner(rng), y = corner(rng), z = corner(rng) / 2;
+      boxes.push_back({x, y, z, x + size(rng), y + size(rng), z + size(rng) / 2});
+    }
+    StateGrid g(0.1);
+    for (int z = 0; z < 8; ++z)
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 20; ++x) {
+          const VoxelKey k = o + VoxelKey{x, y, z};
+          bool occupied = false;
+          if (sc.random_boxes) {
+            for (const auto& b : boxes)
+              occupied |= x >= b[0] && y >= b[1] && z >= b[2] && x < b[3] && y < b[4] && z < b[5];
+          } else {
+            // A slab 9 voxels thick on the window's low-x face (the face is not free space, so its
+            // voxels there are 9 deep), a 3x3x3 block, an L of two thick bars, and, with unknown
+            // as obstacle, the window's top half unknown.
+            const bool slab = x < 9;
+            const bool block = x >= 12 && x < 15 && y >= 5 && y < 8 && z >= 2 && z < 5;
+            const bool bar = (x >= 16 && y >= 10 && z < 3) || (x >= 16 && y >= 13 && z < 6);
+            if (sc.unknown_as_occupied && z >= 4) continue;
+            occupied = slab || block || bar;
+          }
+          g.set_state(k, occupied ? VoxelState::kOccupied : VoxelState::kFree);
+        }
+    ASSERT_TRUE(builder.update(g, center, KeyBox(), 1));
+    EXPECT_EQ(builder.last_inside_transform(), sc.expect_transform) << "budget " << sc.budget;
+    const EsdfGrid& e = builder.grid();
+    int deep = 0;
+    for (int z = 0; z < e.nz; ++z)
+      for (int y = 0; y < e.ny; ++y)
+        for (int x = 0; x < e.nx; ++x) {
+          const float want = brute_distance(g, e, x, y, z);
+          deep += want < -0.06f;
+          ASSERT_NEAR(e.distance[e.index(x, y, z)], want, 1e-5)
+              << x << " " << y << " " << z << " budget " << sc.budget << " unknown "
+              << sc.unknown_as_occupied;
+        }
+    EXPECT_GT(deep, 50) << "random " << sc.random_boxes;  // the scene does test deep voxels
   }
 }
 

@@ -8,8 +8,10 @@
 // are considered: an obstacle just outside it is not seen, so distances near the window border
 // are upper bounds (the window is centred on the vehicle, where the field matters).
 //
-// Computed exactly (Felzenszwalb & Huttenlocher's lower envelope of parabolas, one pass per axis)
-// over the whole window whenever it moved or a state inside it changed.
+// Computed exactly over the whole window whenever it moved or a state inside it changed: outside
+// obstacles by Felzenszwalb & Huttenlocher's lower envelope of parabolas, one pass per axis;
+// inside them by a search around each voxel not on an obstacle's surface, or, when those are
+// too many (thick unknown space counted as an obstacle), by the same transform.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,11 +35,20 @@ class EsdfBuilder {
               bool force = false);
   const EsdfGrid& grid() const { return grid_; }
   const EsdfParams& params() const { return params_; }
+  // Whether the last computation found the inside distances with the full transform (too many
+  // voxels deep inside obstacles for the search); for tests and benchmarks.
+  bool last_inside_transform() const { return last_inside_transform_; }
+  // The search's budget, in voxel visits per window voxel, past which it gives way to the full
+  // transform (the same values either way); 0 = always the transform. Benchmarks compare them.
+  static constexpr double kDefaultSearchBudget = 8.0;
+  void set_inside_search_budget(double visits_per_voxel) { search_budget_ = visits_per_voxel; }
   // Window placement for a vehicle at `center` (exposed for tests and the node).
   VoxelKey window_origin(const Eigen::Vector3d& center) const;
 
  private:
   void compute(const StateGrid& grid);
+  // neg_ = squared distance to the nearest non-obstacle voxel, for the obstacle voxels only.
+  void inside_distances();
 
   EsdfParams params_;
   EsdfGrid grid_;
@@ -45,6 +56,9 @@ class EsdfBuilder {
   std::vector<float> pos_, neg_;
   std::vector<float> line_in_, line_out_, env_z_;
   std::vector<int> env_v_;
+  std::vector<uint32_t> deep_;  // obstacle voxels with no non-obstacle face neighbour
+  bool last_inside_transform_ = false;
+  double search_budget_ = kDefaultSearchBudget;
 };
 
 // Squared Euclidean distance transform, in voxel units, of a dense nx*ny*nz grid (x fastest):
