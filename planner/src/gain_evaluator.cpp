@@ -206,6 +206,7 @@ void GainEvaluator::prepare(double res) {
   const int nz = ((mapper::kBlockMask + hz_) >> mapper::kBlockBits) - block_lo_z_ + 1;
   block_ptr_.assign(static_cast<size_t>(block_n_) * block_n_ * nz, nullptr);
   block_stamp_.assign(block_ptr_.size(), 0u);
+  ignored_ptr_.assign(block_ptr_.size(), nullptr);
   stamp_ = 0;
 }
 
@@ -239,6 +240,8 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
   const int ox = origin.x & mapper::kBlockMask, oy = origin.y & mapper::kBlockMask,
             oz = origin.z & mapper::kBlockMask;
   const mapper::VoxelBlock* origin_b = grid.find_block(origin_block);
+  const bool ignore = ignored_ && !ignored_->empty();
+  const VoxelSet::Mask* origin_ignored = ignore ? ignored_->block_mask(origin_block) : nullptr;
   if (++stamp_ == 0) {  // wrapped: forget every stamp
     std::fill(block_stamp_.begin(), block_stamp_.end(), 0u);
     stamp_ = 1;
@@ -250,6 +253,7 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
     // when the offset leaves the one looked up last.
     int cur_bx = 0, cur_by = 0, cur_bz = 0;
     const mapper::VoxelBlock* b = origin_b;
+    const VoxelSet::Mask* ignored_mask = origin_ignored;
     const RayStep* it = &ray_steps_[ray_begin_[ray]];
     const RayStep* const end = &ray_steps_[ray_begin_[ray + 1]];
     for (; it != end; ++it) {
@@ -265,9 +269,12 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
             (bx - block_lo_) + block_n_ * ((by - block_lo_) + block_n_ * (bz - block_lo_z_)));
         if (block_stamp_[slot] != stamp_) {
           block_stamp_[slot] = stamp_;
-          block_ptr_[slot] = grid.find_block({origin_block.x + bx, origin_block.y + by, origin_block.z + bz});
+          const VoxelKey block{origin_block.x + bx, origin_block.y + by, origin_block.z + bz};
+          block_ptr_[slot] = grid.find_block(block);
+          ignored_ptr_[slot] = ignore ? ignored_->block_mask(block) : nullptr;
         }
         b = block_ptr_[slot];
+        ignored_mask = ignored_ptr_[slot];
       }
       const int lx = ux & mapper::kBlockMask, ly = uy & mapper::kBlockMask, lz = uz & mapper::kBlockMask;
       const size_t li =
@@ -304,7 +311,7 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
           kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
         }
       }
-      if (in_sector(c) && !(ignored_ && !ignored_->empty() && ignored_->count(k)) &&
+      if (in_sector(c) && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li))) &&
           (known_kind || classify(neighbour_reader, k, kind))) {
         const int bin = bin_near(c, ray_bin);
         add(g, bin, kind);
@@ -340,7 +347,7 @@ NodeGain GainEvaluator::evaluate_exact(const mapper::StateGrid& grid, const Eige
         const Eigen::Vector3d c = km.center(k) - p;
         if (!in_sector(c)) continue;
         GainVoxel kind;
-        if (ignored_ && ignored_->count(k)) continue;
+        if (ignored_ && ignored_->contains(k)) continue;
         if (!classify(r, k, kind)) continue;
         if (!grid.is_visible(p, km.center(k), false)) continue;
         add(g, bin_of(std::atan2(c.y(), c.x())), kind);

@@ -61,6 +61,39 @@ TEST(Gain, CountsEachVoxelKindWithItsWeight) {
   EXPECT_EQ(exact.bin_count, r.bin_count);
 }
 
+// Ignored voxels (the unobservable ones) count for nothing, whichever block they are in: the ray
+// walk reads them from the block masks, the exhaustive reference from the set.
+TEST(Gain, IgnoredVoxelsCountForNothing) {
+  mapper::StateGrid g = free_scene();
+  // Cubes straddling block boundaries (blocks are 16 voxels: keys -1|0 and 15|16) and in
+  // negative blocks.
+  unknown_cube(g, {15, 0, 0});
+  unknown_cube(g, {-15, -1, 0});
+  unknown_cube(g, {0, 16, -1});
+  GainEvaluator e(dense_config());
+  const NodeGain all = e.evaluate(g, kNode);
+  ASSERT_EQ(all.total_voxels(), 3 * 27);
+  // Every other voxel of the three cubes.
+  VoxelSet ignored;
+  int n = 0;
+  for (const VoxelKey c : {VoxelKey{15, 0, 0}, VoxelKey{-15, -1, 0}, VoxelKey{0, 16, -1}})
+    for (int z = -1; z <= 1; ++z)
+      for (int y = -1; y <= 1; ++y)
+        for (int x = -1; x <= 1; ++x)
+          if (++n % 2 == 0) ignored.insert({c.x + x, c.y + y, c.z + z});
+  ASSERT_EQ(ignored.size(), 40u);
+  e.set_ignored(&ignored);
+  const NodeGain some = e.evaluate(g, kNode);
+  EXPECT_EQ(some.total_voxels(), 3 * 27 - 40);
+  EXPECT_EQ(e.evaluate_exact(g, kNode).bin_count, some.bin_count);
+  // The cubes' middle ("normal") voxels are the 14th, 41st and 68th: only the second is kept.
+  int64_t normal = 0;
+  for (const auto& bin : some.bin_count) normal += bin[0];
+  EXPECT_EQ(normal, 1);
+  ignored.clear();
+  EXPECT_EQ(e.evaluate(g, kNode).bin_count, all.bin_count);
+}
+
 TEST(Gain, WeightsAreConfigurable) {
   mapper::StateGrid g = free_scene();
   unknown_cube(g, {15, 0, 0});

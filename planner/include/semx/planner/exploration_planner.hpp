@@ -28,7 +28,6 @@
 
 #include <memory>
 #include <optional>
-#include <unordered_set>
 #include <vector>
 
 #include "semx/mapper/map_delta.hpp"
@@ -41,6 +40,7 @@
 #include "semx/planner/rng.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/strategy.hpp"
+#include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
 
@@ -87,7 +87,7 @@ class ExplorationPlanner {
   bool busy() const { return pending_.active; }
   const StatusReport& last_status() const { return last_status_; }
   const FrontierTracker& frontiers() const { return frontiers_; }
-  const std::unordered_set<mapper::VoxelKey>& unobservable() const { return unobservable_; }
+  const VoxelSet& unobservable() const { return unobservable_; }
   Strategy& strategy() { return *strategy_; }
   const std::vector<SemanticRegion>& regions() const { return regions_; }
 
@@ -122,7 +122,7 @@ class ExplorationPlanner {
   CollisionChecker checker_;
   FrontierTracker frontiers_;
   GainEvaluator gains_;
-  std::unordered_set<mapper::VoxelKey> unobservable_;
+  VoxelSet unobservable_;
   int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
   int64_t short_since_ = -1;    // since when the controller holds away from the goal
   Rng rng_;

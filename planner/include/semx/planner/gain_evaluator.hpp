@@ -28,11 +28,11 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
-#include <unordered_set>
 #include <vector>
 
 #include "semx/mapper/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
+#include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
 
@@ -77,8 +77,9 @@ class GainEvaluator {
   // As evaluate(), also listing the voxels counted in the window centred nearest to `yaw`.
   NodeGain evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
                     std::vector<mapper::VoxelKey>* counted, GainStats* stats = nullptr);
-  // Voxels never to count (unobservable_set.hpp); null for none. Must outlive the evaluator's use.
-  void set_ignored(const std::unordered_set<mapper::VoxelKey>* ignored) { ignored_ = ignored; }
+  // Voxels never to count (the unobservable ones, exploration_planner.hpp); null for none. Must
+  // outlive the evaluator's use.
+  void set_ignored(const VoxelSet* ignored) { ignored_ = ignored; }
   // Every voxel of the sector, each tested with its own line of sight (reference for tests).
   NodeGain evaluate_exact(const mapper::StateGrid& grid, const Eigen::Vector3d& p) const;
 
@@ -113,12 +114,13 @@ class GainEvaluator {
   std::vector<uint32_t> ray_begin_;
   // The blocks around the node's, looked up in this evaluation (block_stamp_ == stamp_).
   std::vector<const mapper::VoxelBlock*> block_ptr_;
+  std::vector<const VoxelSet::Mask*> ignored_ptr_;  // the ignored voxels of the same blocks
   std::vector<uint32_t> block_stamp_;
   uint32_t stamp_ = 0;
   int block_lo_ = 0, block_lo_z_ = 0, block_n_ = 0;
   // Scratch: one bit per voxel of the box around the node, "already counted".
   std::vector<uint64_t> seen_;
-  const std::unordered_set<mapper::VoxelKey>* ignored_ = nullptr;
+  const VoxelSet* ignored_ = nullptr;
   double seen_res_ = 0.0;
   int hx_ = 0, hz_ = 0;
 };

@@ -8,7 +8,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <unordered_set>
 #include <vector>
 
 #include "semx/mapper/map_delta.hpp"
@@ -18,6 +17,7 @@
 #include "semx/planner/planner_config.hpp"
 #include "semx/planner/rng.hpp"
 #include "semx/planner/semantic_reward.hpp"
+#include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
 
@@ -27,7 +27,7 @@ struct PlanContext {
   const std::vector<SemanticRegion>* regions = nullptr;  // empty when semantics are off
   const FrontierTracker* frontiers = nullptr;
   // Voxels that gains ignore (seen as unobservable after a visit; exploration_planner.hpp).
-  const std::unordered_set<mapper::VoxelKey>* unobservable = nullptr;
+  const VoxelSet* unobservable = nullptr;
   int64_t cycle = 0;
   bool recovering = false;  // the previous cycles found no goal: sample for frontiers
   Rng* rng = nullptr;
