@@ -305,8 +305,13 @@ void Node::publish_status() {
   // Counted before building, so the status a reader sees includes the status being sent.
   const auto s = status();
   publish(channels::NODE_STATUS, s);
-  next_status_ = std::chrono::steady_clock::now() +
-                 std::chrono::microseconds(static_cast<int64_t>(options_.status_period_s * 1e6));
+  double next_s = options_.status_period_s;
+  constexpr std::size_t kAnnouncements = sizeof(kAnnounceDelaysS) / sizeof(kAnnounceDelaysS[0]);
+  if (options_.announce && announcements_ < kAnnouncements)
+    next_s = std::min(next_s, kAnnounceDelaysS[announcements_]);
+  ++announcements_;
+  next_status_ =
+      std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<int64_t>(next_s * 1e6));
 }
 
 int Node::spin_once(int timeout_ms) {

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
     runtime::NodeFlags flags("simulator");
     std::string world = "env1", config_file, clock = "realtime", nodes;
     std::vector<std::string> sets;
-    double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10;
+    double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10, ready_timeout = 30;
     bool compress = false, raw = false, no_rgb = false;
     runtime::ArgParser p(
         "semx-simulator",
@@ -34,6 +34,11 @@ int main(int argc, char** argv) {
         .option("period-ms", "MS", "tick length in simulated ms (default 10, the odometry period)",
                 &period_ms)
         .option("progress", "S", "simulated seconds between progress lines (0: none, default 10)", &progress)
+        .option(
+            "ready-timeout", "S",
+            "wall seconds to wait for every --lockstep-nodes node's NODE_STATUS before the first tick "
+            "(default 30)",
+            &ready_timeout)
         .flag("compress", "zlib-compress every image payload (smaller logs, slower)", &compress)
         .flag("raw-images", "send every image uncompressed (default: labels and RGB run-length coded)", &raw)
         .flag("no-rgb", "do not render or publish CAMERA_RGB", &no_rgb);
@@ -43,6 +48,7 @@ int main(int argc, char** argv) {
     if (!(period_ms > 0)) throw runtime::ArgError("--period-ms must be positive");
     if (!(speed > 0)) throw runtime::ArgError("--speed must be positive");
     if (duration < 0) throw runtime::ArgError("--duration must not be negative");
+    if (!(ready_timeout >= 0)) throw runtime::ArgError("--ready-timeout must not be negative");
 
     const auto cfg = runtime::load_config<simulator::SimulatorConfig>(config_file, sets);
     const std::string path = world.find('/') == std::string::npos && world.find(".yaml") == std::string::npos
@@ -66,6 +72,7 @@ int main(int argc, char** argv) {
     if (raw) o.label_codec = o.rgb_codec = runtime::ImageCompression::kNone;
     if (no_rgb) o.render_channels = simulator::kRenderDepth | simulator::kRenderLabels;
     o.progress_every_s = progress;
+    o.ready_timeout_s = ready_timeout;
 
     auto node_options = flags.options();
     node_options.follow_clock = false;  // it is the clock

@@ -2,6 +2,7 @@
 
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
+#include <semx/node_status_t.hpp>
 #include <semx/sim_event_t.hpp>
 
 #include <algorithm>
@@ -32,6 +33,31 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     server_.on_ack(a.node, a.tick, a.quiet_until, wall_seconds());
   });
   next_progress_s_ = options_.progress_every_s;
+  const auto& nodes = options_.clock.lockstep_nodes;
+  if (!nodes.empty()) {
+    ready_ = false;
+    node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& s) {
+      const auto& want = options_.clock.lockstep_nodes;
+      const bool up = s.state == static_cast<int8_t>(runtime::NodeState::kRunning) ||
+                      s.state == static_cast<int8_t>(runtime::NodeState::kDegraded);
+      if (up && std::find(want.begin(), want.end(), s.node) != want.end()) heard_.insert(s.node);
+    });
+  }
+}
+
+bool SimulatorNode::check_ready(double wall_s) {
+  if (wait_start_ < 0) wait_start_ = wall_s;
+  std::vector<std::string> missing;
+  for (const std::string& n : options_.clock.lockstep_nodes) {
+    if (!heard_.count(n)) missing.push_back(n);
+  }
+  if (missing.empty()) return ready_ = true;
+  if (wall_s - wait_start_ < options_.ready_timeout_s) return false;
+  std::string names;
+  for (const std::string& n : missing) names += (names.empty() ? "" : ", ") + n;
+  std::fprintf(stderr, "semx-simulator: starting without a NODE_STATUS from %s after %.0f s\n", names.c_str(),
+               options_.ready_timeout_s);
+  return ready_ = true;
 }
 
 void SimulatorNode::on_command(const semx::control_cmd_t& m) {
@@ -97,8 +123,9 @@ void SimulatorNode::publish_clock(const runtime::ClockTick& t) {
 }
 
 bool SimulatorNode::poll(double wall_s) {
-  if (wall_start_ < 0) wall_start_ = wall_s;
   node_.drain();
+  if (!ready_ && !check_ready(wall_s)) return true;
+  if (wall_start_ < 0) wall_start_ = wall_s;
   if (server_.finished()) return false;
   if (auto t = server_.poll(wall_s)) {
     if (!t->resend) advance_to(t->utime);

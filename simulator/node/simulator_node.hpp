@@ -2,12 +2,17 @@
 // over LCM (DESIGN.md §1, §3). Each tick it steps physics up to the tick's time, publishes every
 // sensor sample that fell due (IMU, odometry, camera frames, events), and only then SIM_CLOCK, so
 // a node that handled SIM_CLOCK(k) has seen all data up to k. In LOCKSTEP the next tick waits for
-// the registered nodes' acks; with none registered the simulation runs as fast as it can.
+// the registered nodes' acks; with none registered the simulation runs as fast as it can. Before
+// its first tick the simulator waits until it has heard every registered node report itself
+// running (NODE_STATUS): a node that subscribed late would miss the initial frame and events,
+// which the clock's resent ticks do not repeat, and a run would depend on start-up timing (a
+// launcher's fixed delay used to stand in for this; a loaded machine could outlast it).
 #pragma once
 
 #include <semx/control_cmd_t.hpp>
 
 #include <cstdint>
+#include <set>
 #include <string>
 
 #include "semx/runtime/clock_server.hpp"
@@ -26,7 +31,10 @@ struct SimulatorNodeOptions {
   runtime::ImageCompression rgb_codec = runtime::ImageCompression::kRle;
   // RGB as runs: the same image and payload, without an image to write and scan.
   unsigned render_channels = kRenderDepth | kRenderLabels | kRenderRgbRuns;
-  double progress_every_s = 10.0;    // simulated seconds between progress lines (0: none)
+  double progress_every_s = 10.0;  // simulated seconds between progress lines (0: none)
+  // Wall seconds to wait for the registered nodes before starting without the silent ones (named
+  // on stderr; in LOCKSTEP the clock still waits for their acks).
+  double ready_timeout_s = 30.0;
 };
 
 class SimulatorNode {
@@ -42,13 +50,18 @@ class SimulatorNode {
   int64_t ticks() const { return server_.current_tick() + 1; }
   int64_t frames_published() const { return frames_; }
   int64_t commands_rejected() const { return rejected_; }
+  // Every registered node was heard (or the wait timed out); true at once with none registered.
+  bool ready() const { return ready_; }
 
  private:
   void advance_to(int64_t utime);
   void publish_frame();
   void publish_clock(const runtime::ClockTick& t);
-  void publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid, int64_t count);
+  void publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid,
+                     int64_t count);
   void on_command(const semx::control_cmd_t& m);
+  // LOCKSTEP before the first tick: whether to start now (everyone heard, or the wait timed out).
+  bool check_ready(double wall_s);
 
   Simulator& sim_;
   runtime::Node& node_;
@@ -60,6 +73,9 @@ class SimulatorNode {
   int64_t rejected_ = 0;
   double next_progress_s_ = 0;
   double wall_start_ = -1;
+  bool ready_ = true;
+  double wait_start_ = -1;
+  std::set<std::string> heard_;  // registered nodes heard running
 };
 
 }  // namespace semx::simulator

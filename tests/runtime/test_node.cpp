@@ -1,6 +1,8 @@
 // The node runtime over memq:// (one process, publish and handle on the same LCM object).
 #include <gtest/gtest.h>
+
 #include <unistd.h>
+#include <chrono>
 
 #include <fstream>
 #include <random>
@@ -56,6 +58,22 @@ int64_t rss_kb() {
 }
 
 }  // namespace
+
+// A launched node repeats its first NODE_STATUS a few times within a second (the lockstep
+// simulator waits to hear it), then keeps to its heartbeat period.
+TEST(Node, AnnouncesItselfAFewTimesAfterStarting) {
+  for (const bool announce : {false, true}) {
+    NodeOptions o = memq("announcer");
+    o.announce = announce;
+    Node n(o);
+    int statuses = 0;
+    n.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t&) { ++statuses; });
+    // Statuses at 0, 0.05, 0.15, 0.35 and 0.75 s with announce; the next one 1000 s later.
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
+    while (std::chrono::steady_clock::now() < end) n.spin_once(10);
+    EXPECT_EQ(statuses, announce ? 5 : 1) << "announce " << announce;
+  }
+}
 
 TEST(Node, TypedRoundTripIsCounted) {
   Node n(memq("t"));

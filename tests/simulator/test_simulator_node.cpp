@@ -7,6 +7,7 @@
 #include <semx/control_cmd_t.hpp>
 #include <semx/depth_image_t.hpp>
 #include <semx/label_image_t.hpp>
+#include <semx/node_status_t.hpp>
 #include <semx/odometry_t.hpp>
 #include <semx/sim_event_t.hpp>
 
@@ -260,6 +261,54 @@ TEST(SimulatorNode, SameSeedSameMessageStream) {
   }
 }
 
+void announce(runtime::Node& node, const std::string& who,
+              runtime::NodeState state = runtime::NodeState::kRunning) {
+  semx::node_status_t st{};
+  st.node = who;
+  st.state = static_cast<int8_t>(state);
+  node.publish("NODE_STATUS", st);
+}
+
+// The first tick (with the initial frame, which resent ticks do not repeat) waits until every
+// registered node said it is running, or until the wait times out.
+TEST(SimulatorNode, LockstepStartsOnceEveryRegisteredNodeIsRunning) {
+  SimulatorConfig cfg;
+  Simulator sim(test::shipped("env1"), cfg);
+  for (const bool timeout : {false, true}) {
+    runtime::Node node(memq_node());
+    std::vector<std::string> seen;
+    node.subscribe_raw("CAMERA_DEPTH|SIM_CLOCK|SIM_EVENT|ODOMETRY",
+                       [&](const std::string& ch, const uint8_t*, std::size_t) { seen.push_back(ch); });
+    auto options = lockstep(-1);
+    options.clock.lockstep_nodes = {"mapper", "planner"};
+    options.ready_timeout_s = 2.0;
+    SimulatorNode sn(sim, node, options);
+    double wall = 0;
+    auto spin = [&](int n) {
+      for (int i = 0; i < n; ++i) sn.poll(wall += 0.001);
+      node.drain();
+    };
+    spin(5);
+    announce(node, "mapper", runtime::NodeState::kStarting);  // not running yet
+    announce(node, "viewer");                                 // not registered
+    announce(node, "planner");
+    spin(5);
+    EXPECT_TRUE(seen.empty()) << "published " << seen.front() << " before the mapper ran";
+    EXPECT_FALSE(sn.ready());
+    if (timeout) {
+      wall += 2.0;
+    } else {
+      announce(node, "mapper");
+    }
+    spin(5);
+    EXPECT_TRUE(sn.ready());
+    ASSERT_FALSE(seen.empty());
+    // The initial state goes out with tick 0.
+    EXPECT_NE(std::find(seen.begin(), seen.end(), "CAMERA_DEPTH"), seen.end());
+    EXPECT_EQ(seen.back(), "SIM_CLOCK");
+  }
+}
+
 TEST(SimulatorNode, LockstepWaitsForEveryRegisteredNodesAck) {
   SimulatorConfig cfg;
   Simulator sim(test::shipped("env1"), cfg);
@@ -277,6 +326,8 @@ TEST(SimulatorNode, LockstepWaitsForEveryRegisteredNodesAck) {
     node.publish("SIM_ACK", a);
   };
   double wall = 0;
+  announce(node, "mapper");
+  announce(node, "planner");
   for (int i = 0; i < 5; ++i) sn.poll(wall += 0.001);
   node.drain();
   EXPECT_EQ(ticks, std::vector<int64_t>{0}) << "no tick 1 before the acks";

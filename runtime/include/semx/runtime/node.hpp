@@ -40,6 +40,10 @@ struct NodeOptions {
   double status_period_s = 1.0;               // NODE_STATUS heartbeat, wall clock
   std::size_t max_message_bytes = 32u << 20;  // larger messages are dropped unread
   bool quiet = false;                         // no log lines for dropped messages
+  // Repeat the first NODE_STATUS after kAnnounceDelaysS (wall), before the heartbeat settles to
+  // status_period_s: a process started at the same time (the lockstep simulator, which waits to
+  // hear every node it must wait for) hears this one within a fraction of a second, not a period.
+  bool announce = false;
 };
 
 struct ChannelCounters {
@@ -123,6 +127,7 @@ class Node {
   // half the run's messages). The clock counts a promise at most ClockServerConfig::max_slack_us
   // (100 ms) past the acked tick, so it never waits for a skipped one. Resent ticks are acked.
   static constexpr int64_t kAckIntervalUs = 50000;
+  static constexpr double kAnnounceDelaysS[] = {0.05, 0.1, 0.2, 0.4};
   bool may_publish() const;
   // Drops this node's last promise: for a node that saw no tick for a while of wall time (the
   // simulator ended) and must answer anyway (the mapper's last snapshot request).
@@ -187,6 +192,7 @@ class Node {
   std::map<std::string, ChannelCounters> incoming_;
   std::map<std::string, ChannelCounters> outgoing_;
   std::chrono::steady_clock::time_point next_status_;
+  std::size_t announcements_ = 0;  // statuses sent so far, up to the announce delays' count
   bool stop_ = false;
 };
 

@@ -35,6 +35,7 @@ struct NodeFlags {
     o.lockstep = lockstep;
     o.status_period_s = status_period_s;
     o.quiet = quiet;
+    o.announce = true;  // processes started together by a launcher find each other at once
     return o;
   }
 };
