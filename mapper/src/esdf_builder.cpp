@@ -184,8 +184,7 @@ void EsdfBuilder::compute(const StateGrid& grid) {
   if (search_budget_ > 0.0) {
     inside_distances();
   } else {
-    squared_edt(obstacle_.data(), 0, nx, ny, nz, neg_.data(), line_in_, line_out_, env_z_, env_v_);
-    last_inside_transform_ = true;
+    inside_transform();
   }
   const float res = static_cast<float>(grid_.resolution);
   const float dmax = static_cast<float>(params_.max_distance);
@@ -193,6 +192,12 @@ void EsdfBuilder::compute(const StateGrid& grid) {
     const float d = obstacle_[i] ? -(std::sqrt(neg_[i]) - 0.5f) * res : (std::sqrt(pos_[i]) - 0.5f) * res;
     grid_.distance[i] = std::min(std::max(d, -dmax), dmax);
   }
+}
+
+void EsdfBuilder::inside_transform() {
+  squared_edt(obstacle_.data(), 0, grid_.nx, grid_.ny, grid_.nz, neg_.data(), line_in_, line_out_, env_z_,
+              env_v_);
+  last_inside_transform_ = true;
 }
 
 void EsdfBuilder::inside_distances() {
@@ -226,9 +231,9 @@ void EsdfBuilder::inside_distances() {
       }
     }
   }
-  last_inside_transform_ = deep_.size() > max_deep;
-  if (last_inside_transform_) {
-    squared_edt(obstacle_.data(), 0, nx, ny, nz, neg_.data(), line_in_, line_out_, env_z_, env_v_);
+  last_inside_transform_ = false;
+  if (deep_.size() > max_deep) {
+    inside_transform();
     return;
   }
   if (deep_.empty()) return;
@@ -278,8 +283,7 @@ void EsdfBuilder::inside_distances() {
       if (budget < 0) break;
     }
     if (budget < 0) {
-      squared_edt(obstacle_.data(), 0, nx, ny, nz, neg_.data(), line_in_, line_out_, env_z_, env_v_);
-      last_inside_transform_ = true;
+      inside_transform();
       return;
     }
     neg[i] = best == std::numeric_limits<int64_t>::max() ? kEdtInfinity : static_cast<float>(best);

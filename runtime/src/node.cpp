@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_url.hpp"
@@ -306,8 +307,7 @@ void Node::publish_status() {
   const auto s = status();
   publish(channels::NODE_STATUS, s);
   double next_s = options_.status_period_s;
-  constexpr std::size_t kAnnouncements = sizeof(kAnnounceDelaysS) / sizeof(kAnnounceDelaysS[0]);
-  if (options_.announce && announcements_ < kAnnouncements)
+  if (options_.announce && announcements_ < std::size(kAnnounceDelaysS))
     next_s = std::min(next_s, kAnnounceDelaysS[announcements_]);
   ++announcements_;
   next_status_ =

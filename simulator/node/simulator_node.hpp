@@ -60,7 +60,7 @@ class SimulatorNode {
   void publish_event(int8_t type, const std::string& text, const Eigen::Vector3d& where, int solid,
                      int64_t count);
   void on_command(const semx::control_cmd_t& m);
-  // LOCKSTEP before the first tick: whether to start now (everyone heard, or the wait timed out).
+  // Before the first tick: whether to start now (everyone heard, or the wait timed out).
   bool check_ready(double wall_s);
 
   Simulator& sim_;

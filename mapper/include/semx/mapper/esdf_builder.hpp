@@ -49,6 +49,8 @@ class EsdfBuilder {
   void compute(const StateGrid& grid);
   // neg_ = squared distance to the nearest non-obstacle voxel, for the obstacle voxels only.
   void inside_distances();
+  // The same for every voxel by the full transform (sites: the non-obstacle voxels).
+  void inside_transform();
 
   EsdfParams params_;
   EsdfGrid grid_;
