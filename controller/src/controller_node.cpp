@@ -26,6 +26,13 @@ ControllerNode::ControllerNode(runtime::NodeOptions options, const ControllerCon
       semx::channels::ODOMETRY,
       [this](const semx::odometry_t& m) { controller_.on_odometry(to_vehicle_state(m)); }, accept_odometry);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
+  // The controller publishes only on its control steps, so the clock need not wait for it on the
+  // ticks between them (rate_hz below the clock's tick rate). At the tick rate this promises
+  // nothing: the next step is the next tick.
+  node_.on_quiet_until([this](int64_t utime) {
+    if (last_step_utime_ < 0 || last_step_utime_ > utime) return utime;
+    return last_step_utime_ + step_period_us() - 1;
+  });
   node_.set_state(runtime::NodeState::kRunning, "waiting for inputs");
 }
 
@@ -37,8 +44,7 @@ void ControllerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   }
   // Run at rate_hz of simulation time whatever the clock's tick period (1 µs of slack for
   // periods that do not divide evenly into microseconds).
-  const int64_t period = static_cast<int64_t>(std::llround(1e6 / config_.rate_hz));
-  if (last_step_utime_ >= 0 && utime - last_step_utime_ < period - 1) return;
+  if (last_step_utime_ >= 0 && utime - last_step_utime_ < step_period_us() - 1) return;
   last_step_utime_ = utime;
 
   const StepOutput out = controller_.step(utime);
@@ -67,9 +73,14 @@ int ControllerNode::run() {
   std::cout << "semx-controller: paths " << c.paths << ", trajectories " << c.trajectories << " (optimised "
             << c.optimized << " (slowed " << c.slowed << "), fallback " << c.fallbacks << ": strayed "
             << c.fallback_strays << ", too close " << c.fallback_too_close << "), squared headings "
-            << c.squared_headings << ", repaired headings " << c.repaired_headings << ", rejected " << c.rejected << ", unsafe " << c.unsafe << ", brakes "
-            << c.brakes << ", stale stops " << c.stale_stops << std::endl;
+            << c.squared_headings << ", repaired headings " << c.repaired_headings << ", rejected "
+            << c.rejected << ", unsafe " << c.unsafe << ", brakes " << c.brakes << ", stale stops "
+            << c.stale_stops << std::endl;
   return code;
+}
+
+int64_t ControllerNode::step_period_us() const {
+  return static_cast<int64_t>(std::llround(1e6 / config_.rate_hz));
 }
 
 void ControllerNode::publish_status(const ControllerStatus& s, int64_t utime) {

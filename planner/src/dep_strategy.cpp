@@ -9,6 +9,7 @@
 
 #include "semx/planner/angles.hpp"
 #include "semx/planner/travel_cost.hpp"
+#include "semx/runtime/semantic_classes.hpp"
 #include "stopwatch.hpp"
 
 namespace semx::planner {
@@ -394,17 +395,30 @@ double DepStrategy::score_of(PlanContext& ctx, const ScoreFn& score, int64_t id)
 
 double DepStrategy::reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const {
   if (!semantic_ || !ctx.regions) return 0.0;
+  if (cycle_regions_.size() == ctx.regions->size())
+    return semantic_reward(p, cycle_regions_, &region_factor_);
   return semantic_reward(p, *ctx.regions, &region_factor_);
 }
 
 void DepStrategy::update_region_factors(PlanContext& ctx) {
   region_factor_.clear();
+  cycle_regions_.clear();
   const double kappa = config_.reward.unexplored_weight;
-  if (!semantic_ || !ctx.regions || !(kappa > 0)) return;
+  const double kappa_door = config_.reward.passage_weight;
+  if (!semantic_ || !ctx.regions || !(kappa > 0 || kappa_door > 0)) return;
   region_factor_.assign(ctx.regions->size(), 1.0);
-  for (size_t i = 0; i < ctx.regions->size(); ++i) {
-    const SemanticRegion& s = (*ctx.regions)[i];
-    if (!s.active || !(s.radius > 0) || !std::isfinite(s.radius) || !s.centroid.allFinite()) continue;
+  cycle_regions_ = *ctx.regions;
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  for (size_t i = 0; i < cycle_regions_.size(); ++i) {
+    SemanticRegion& s = cycle_regions_[i];
+    const bool passage = kappa_door > 0 && s.class_id == door;
+    const double k = passage ? kappa_door : kappa;
+    if (passage) {
+      region_factor_[i] = s.active ? 1.0 : 0.0;
+      s.active = true;
+    }
+    if (!(k > 0) || !s.active || !(s.radius > 0) || !std::isfinite(s.radius) || !s.centroid.allFinite())
+      continue;
     // The node nearest the centroid stands for the object's surroundings: a centroid lies inside
     // the object, where rays start in occupied or unknown voxels, and a node is known free. Its
     // cached gain is reused (stale is re-evaluated, once per region at most).
@@ -414,7 +428,7 @@ void DepStrategy::update_region_factors(PlanContext& ctx) {
     if (!n.gain.valid || n.gain_stale) evaluate_gain(ctx, n.id);
     double all_round = 0.0;
     for (float b : n.gain.bin_gain) all_round += b;
-    region_factor_[i] = 1.0 + kappa * all_round;
+    region_factor_[i] += k * all_round;
   }
 }
 

@@ -2,6 +2,7 @@
 // control step on SIM_CLOCK ticks, and what it publishes.
 #include <gtest/gtest.h>
 
+#include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 
 #include "semx/controller/controller_node.hpp"
@@ -208,6 +209,46 @@ TEST(ControllerNode, RunsAtItsRateWhateverTheClockPeriod) {
   Harness h;
   h.advance(100, 1'000);  // 1 ms ticks for 0.1 s: 10 steps at 100 Hz
   EXPECT_EQ(h.commands.size(), 10u);
+}
+
+// In LOCKSTEP the controller promises quiet until its next control step, so the clock waits for
+// it only on the ticks it steps on; at the tick rate the promise is no wider than one tick.
+TEST(ControllerNode, PromisesQuietUntilItsNextControlStep) {
+  for (double rate : {50.0, 100.0}) {
+    SCOPED_TRACE(rate);
+    semx::runtime::NodeOptions o = memq();
+    o.lockstep = true;
+    ControllerConfig c;
+    c.rate_hz = rate;
+    ControllerNode cn(o, c);
+    std::vector<semx::ack_t> acks;
+    std::vector<int64_t> command_times;
+    cn.node().subscribe<semx::ack_t>(ch::SIM_ACK, [&](const semx::ack_t& a) { acks.push_back(a); });
+    cn.node().subscribe<semx::control_cmd_t>(
+        ch::CONTROL_CMD, [&](const semx::control_cmd_t& m) { command_times.push_back(m.utime); });
+    int64_t promised = 0;  // the last promise heard before each command
+    std::vector<int64_t> promise_at_command;
+    for (int64_t tick = 0; tick <= 20; ++tick) {
+      const size_t before = command_times.size();
+      cn.node().publish(ch::SIM_CLOCK, clock_message(tick, tick * 10'000));
+      cn.node().drain();
+      cn.node().drain();
+      if (command_times.size() > before) promise_at_command.push_back(promised);
+      if (!acks.empty()) promised = acks.back().quiet_until;
+    }
+    const size_t steps = rate == 50.0 ? 11u : 21u;
+    ASSERT_EQ(command_times.size(), steps);
+    for (size_t i = 0; i < command_times.size(); ++i) {
+      EXPECT_EQ(command_times[i], static_cast<int64_t>(i) * (rate == 50.0 ? 20'000 : 10'000));
+      EXPECT_LE(promise_at_command[i], command_times[i]) << "a command inside the promise";
+    }
+    ASSERT_FALSE(acks.empty());
+    if (rate == 50.0) {
+      EXPECT_EQ(acks.front().quiet_until, 19'999);  // after the step at 0: the next at 20 ms
+    } else {
+      for (const semx::ack_t& a : acks) EXPECT_LT(a.quiet_until, a.utime + 10'000);
+    }
+  }
 }
 
 TEST(ControllerNode, AClockRestartIsANewEpisode) {

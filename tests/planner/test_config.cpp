@@ -58,6 +58,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(cost.min_time);
   SAME(cost.turn_while_flying);
   SAME(reward.unexplored_weight);
+  SAME(reward.passage_weight);
   SAME(loop.goal_tolerance);
   SAME(loop.yaw_tolerance);
   SAME(loop.dwell_s);
@@ -112,6 +113,8 @@ TEST(PlannerConfig, TheShippedAblationsLoad) {
   EXPECT_FALSE(load_config<PlannerConfig>(dir + "paper_travel_cost.yaml").cost.turn_while_flying);
   EXPECT_EQ(load_config<PlannerConfig>(dir + "unexplored_weight_0.001.yaml").reward.unexplored_weight, 0.001);
   EXPECT_EQ(load_config<PlannerConfig>(dir + "unexplored_weight_0.003.yaml").reward.unexplored_weight, 0.003);
+  EXPECT_EQ(load_config<PlannerConfig>(dir + "passage_weight_0.001.yaml").reward.passage_weight, 0.001);
+  EXPECT_EQ(load_config<PlannerConfig>(dir + "passage_weight_0.0003.yaml").reward.passage_weight, 0.0003);
 }
 
 TEST(PlannerConfig, OverridesAndErrors) {
@@ -123,6 +126,7 @@ TEST(PlannerConfig, OverridesAndErrors) {
   EXPECT_EQ(load_config<PlannerConfig>("", {"reward.unexplored_weight=0.002"}).reward.unexplored_weight,
             0.002);
   EXPECT_THROW(load_config<PlannerConfig>("", {"reward.unexplored_weight=-1"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"reward.passage_weight=-1"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"planner=rrt"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.sample=30"}), ConfigError);
   EXPECT_THROW(load_config<PlannerConfig>("", {"sampling.samples=0"}), ConfigError);

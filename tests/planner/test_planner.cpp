@@ -11,6 +11,7 @@
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/exploration_planner.hpp"
 #include "semx/planner/exploration_sim.hpp"
+#include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
 namespace {
@@ -192,6 +193,55 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
   known.choose();
   ASSERT_GE(known.left, 0);
   EXPECT_NEAR(reward_of(known, known.left), paper, 1e-9);
+}
+
+// reward.passage_weight κ_p: a door rewards w (1 - d/r)(a + κ_p U), a = 1 while active, also once
+// its leaf is fully observed; other classes keep the paper's reward, and κ_p = 0 is the paper's.
+TEST(Planner, PassageWeightScalesADoorByTheGainAroundItEvenOnceObserved) {
+  auto reward_of = [](MirrorScene& s, int64_t id) {
+    for (const RoadmapView::Node& n : s.dep.roadmap(nullptr).nodes)
+      if (n.id == id) return n.reward;
+    ADD_FAILURE() << "node " << id << " not in the roadmap";
+    return -1.0;
+  };
+  SemanticRegion door;
+  door.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
+  door.centroid = Eigen::Vector3d(3.6, 2.05, 1.25);  // 0.45 m from the left node, nearest to it
+  door.weight = 100.0;
+  door.radius = 1.5;
+  const double paper = 100.0 * (1.0 - 0.45 / 1.5);
+  SemanticRegion chair = door;
+  chair.class_id = static_cast<int>(runtime::SemanticClass::kChair);
+
+  for (bool active : {true, false}) {
+    SCOPED_TRACE(active ? "active door" : "observed door");
+    door.active = active;
+    MirrorScene plain;
+    plain.regions = {door};
+    plain.choose();
+    ASSERT_GE(plain.left, 0);
+    EXPECT_NEAR(reward_of(plain, plain.left), active ? paper : 0.0, 1e-9);
+
+    MirrorScene scaled;
+    scaled.config.reward.passage_weight = 1e-3;
+    scaled.restart();
+    scaled.regions = {door};
+    scaled.choose();
+    ASSERT_GE(scaled.left, 0);
+    double all_round = 0.0;
+    for (float b : scaled.dep.graph().node(scaled.left).gain.bin_gain) all_round += b;
+    ASSERT_GT(all_round, 0.0);
+    EXPECT_NEAR(reward_of(scaled, scaled.left), paper * ((active ? 1.0 : 0.0) + 1e-3 * all_round),
+                1e-6 * paper);
+  }
+
+  MirrorScene other;  // not a door: the paper's reward whatever κ_p
+  other.config.reward.passage_weight = 1e-3;
+  other.restart();
+  other.regions = {chair};
+  other.choose();
+  ASSERT_GE(other.left, 0);
+  EXPECT_NEAR(reward_of(other, other.left), paper, 1e-9);
 }
 
 TEST(Planner, DeclaresDoneOnAFullyKnownMap) {

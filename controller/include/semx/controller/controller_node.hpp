@@ -31,6 +31,7 @@ class ControllerNode {
  private:
   void publish_status(const ControllerStatus& s, int64_t utime);
   void update_node_state();
+  int64_t step_period_us() const;  // of rate_hz, in message time
 
   ControllerConfig config_;
   runtime::Node node_;

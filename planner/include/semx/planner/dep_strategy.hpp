@@ -111,7 +111,8 @@ class DepStrategy : public Strategy {
   double score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const;
   // R_sem at p with this cycle's region factors (0 for plain DEP).
   double reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const;
-  // Each region's 1 + κ U_i (config reward.unexplored_weight), for this cycle's regions.
+  // Each region's 1 + κ U_i (config reward.unexplored_weight), or a door's a_i + κ_p U_i
+  // (reward.passage_weight), for this cycle's regions.
   void update_region_factors(PlanContext& ctx);
   // Some voxel of obstacle_voxels_ has its centre within `radius` of the segment a-b.
   bool obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double res) const;
@@ -133,6 +134,8 @@ class DepStrategy : public Strategy {
   Roadmap::Search search_;
   std::vector<double> reward_, cost_, score_;
   std::vector<double> region_factor_;  // one per region of ctx.regions this cycle
+  // ctx.regions with the doors active when passage_weight is on (their factor says how much).
+  std::vector<SemanticRegion> cycle_regions_;
 };
 
 }  // namespace semx::planner

@@ -128,6 +128,12 @@ struct RewardConfig {
   // and draws the vehicle there; one in a mapped room rewards what the paper's Eq. 6 gives.
   // 0: the paper's reward.
   double unexplored_weight = 0.0;
+  // κ_p, per weighted voxel, for door regions only: a door rewards w_i (1 - d_i / r_i)
+  // (a_i + κ_p U_i), a_i = 1 while the region is active and 0 once the leaf is fully observed,
+  // U_i as above. A doorway is a passage: what matters is the unknown volume around it (the room
+  // behind), not whether the leaf itself was seen, so the term outlives the leaf's observation
+  // and fades as the room is mapped. 0: the paper's reward.
+  double passage_weight = 0.0;
 };
 
 // The main loop: when to replan, when to give up.
