@@ -108,6 +108,32 @@ struct MirrorScene {
   }
 };
 
+// R_sem of roadmap node `id` in the scene's last roadmap view.
+double reward_of(MirrorScene& s, int64_t id) {
+  for (const RoadmapView::Node& n : s.dep.roadmap(nullptr).nodes)
+    if (n.id == id) return n.reward;
+  ADD_FAILURE() << "node " << id << " not in the roadmap";
+  return -1.0;
+}
+
+// Node `id`'s gain summed over every yaw bin (the U of the reward ablations).
+double all_round_gain(MirrorScene& s, int64_t id) {
+  double sum = 0.0;
+  for (float b : s.dep.graph().node(id).gain.bin_gain) sum += b;
+  return sum;
+}
+
+// A region 0.45 m from the scene's left node, nearest to it; it rewards that node
+// kNearLeftReward by Eq. 6.
+SemanticRegion near_left_region() {
+  SemanticRegion r;
+  r.centroid = Eigen::Vector3d(3.6, 2.05, 1.25);
+  r.weight = 100.0;
+  r.radius = 1.5;
+  return r;
+}
+constexpr double kNearLeftReward = 100.0 * (1.0 - 0.45 / 1.5);
+
 TEST(Planner, PicksTheSemanticallyRewardedOfTwoEqualNodes) {
   MirrorScene s;
   const Goal plain = s.choose();
@@ -151,17 +177,8 @@ TEST(Planner, PicksTheSemanticallyRewardedOfTwoEqualNodes) {
 // reward.unexplored_weight κ: a region's reward is multiplied by 1 + κ U, U the all-round gain of
 // the roadmap node nearest its centroid; a region in mapped surroundings keeps the paper's reward.
 TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
-  auto reward_of = [](MirrorScene& s, int64_t id) {
-    for (const RoadmapView::Node& n : s.dep.roadmap(nullptr).nodes)
-      if (n.id == id) return n.reward;
-    ADD_FAILURE() << "node " << id << " not in the roadmap";
-    return -1.0;
-  };
-  SemanticRegion r;
-  r.centroid = Eigen::Vector3d(3.6, 2.05, 1.25);  // 0.45 m from the left node, nearest to it
-  r.weight = 100.0;
-  r.radius = 1.5;
-  const double paper = 100.0 * (1.0 - 0.45 / 1.5);
+  const SemanticRegion r = near_left_region();
+  const double paper = kNearLeftReward;
 
   MirrorScene plain;
   plain.regions = {r};
@@ -175,8 +192,7 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
   scaled.regions = {r};
   scaled.choose();
   ASSERT_GE(scaled.left, 0);
-  double all_round = 0.0;
-  for (float b : scaled.dep.graph().node(scaled.left).gain.bin_gain) all_round += b;
+  const double all_round = all_round_gain(scaled, scaled.left);
   ASSERT_GT(all_round, scaled.dep.graph().node(scaled.left).gain.gain);  // more than one window
   EXPECT_NEAR(reward_of(scaled, scaled.left), paper * (1.0 + 1e-3 * all_round), 1e-6 * paper);
   EXPECT_NEAR(reward_of(scaled, scaled.right), 0.0, 1e-12);  // out of the region's reach
@@ -198,18 +214,9 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
 // reward.passage_weight κ_p: a door rewards w (1 - d/r)(a + κ_p U), a = 1 while active, also once
 // its leaf is fully observed; other classes keep the paper's reward, and κ_p = 0 is the paper's.
 TEST(Planner, PassageWeightScalesADoorByTheGainAroundItEvenOnceObserved) {
-  auto reward_of = [](MirrorScene& s, int64_t id) {
-    for (const RoadmapView::Node& n : s.dep.roadmap(nullptr).nodes)
-      if (n.id == id) return n.reward;
-    ADD_FAILURE() << "node " << id << " not in the roadmap";
-    return -1.0;
-  };
-  SemanticRegion door;
+  SemanticRegion door = near_left_region();
   door.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
-  door.centroid = Eigen::Vector3d(3.6, 2.05, 1.25);  // 0.45 m from the left node, nearest to it
-  door.weight = 100.0;
-  door.radius = 1.5;
-  const double paper = 100.0 * (1.0 - 0.45 / 1.5);
+  const double paper = kNearLeftReward;
   SemanticRegion chair = door;
   chair.class_id = static_cast<int>(runtime::SemanticClass::kChair);
 
@@ -228,8 +235,7 @@ TEST(Planner, PassageWeightScalesADoorByTheGainAroundItEvenOnceObserved) {
     scaled.regions = {door};
     scaled.choose();
     ASSERT_GE(scaled.left, 0);
-    double all_round = 0.0;
-    for (float b : scaled.dep.graph().node(scaled.left).gain.bin_gain) all_round += b;
+    const double all_round = all_round_gain(scaled, scaled.left);
     ASSERT_GT(all_round, 0.0);
     EXPECT_NEAR(reward_of(scaled, scaled.left), paper * ((active ? 1.0 : 0.0) + 1e-3 * all_round),
                 1e-6 * paper);
