@@ -1,5 +1,6 @@
 #include "semx/runtime/node.hpp"
 
+#include <poll.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -8,6 +9,7 @@
 #include <cctype>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -87,8 +89,18 @@ void request_shutdown() { g_shutdown.store(true); }
 Node::Node(NodeOptions options) : options_(std::move(options)), clock_(options_.lockstep) {
   if (options_.name.empty()) throw NodeError("a node needs a name");
   options_.lcm_url = resolve_lcm_url(options_.lcm_url);
-  lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
-  if (!lcm_->good()) throw NodeError("cannot open LCM provider '" + options_.lcm_url + "'");
+  const char* transport = std::getenv("SEMX_LCM_TRANSPORT");
+  if (!(transport && std::string(transport) == "liblcm")) udpm_ = parse_udpm_url(options_.lcm_url);
+  if (udpm_) {
+    try {
+      sender_ = std::make_unique<UdpmSender>(*udpm_);
+    } catch (const std::exception& e) {
+      throw NodeError("cannot open LCM provider '" + options_.lcm_url + "': " + e.what());
+    }
+  } else {
+    lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+    if (!lcm_->good()) throw NodeError("cannot open LCM provider '" + options_.lcm_url + "'");
+  }
   if (options_.follow_clock) {
     subscribe<semx::clock_t>(
         channels::SIM_CLOCK, [this](const semx::clock_t& m) { on_clock_message(m); },
@@ -116,8 +128,25 @@ void Node::ensure_lcm_subscription(const std::string& channel) {
       throw NodeError("channel name '" + channel + "' must be letters, digits and '_'");
     }
   }
-  lcm_->subscribe(channel, &Node::on_message, this);
   subs_[channel];
+  if (udpm_) {
+    receive_channels_.push_back(channel);
+    update_receiver();
+  } else {
+    lcm_->subscribe(channel, &Node::on_lcm_message, this);
+  }
+}
+
+void Node::update_receiver() {
+  try {
+    if (!receiver_) receiver_ = std::make_unique<UdpmReceiver>(*udpm_, options_.max_message_bytes);
+    std::vector<std::string> refused;
+    for (const auto& c : never_wanted_)
+      if (!subs_.count(c)) refused.push_back(c);
+    receiver_->filter(receive_channels_, !raw_handlers_.empty(), refused);
+  } catch (const std::exception& e) {
+    throw NodeError(options_.name + ": " + e.what());
+  }
 }
 
 void Node::skip_unless(const std::string& channel, std::function<bool(int64_t utime)> wanted) {
@@ -125,24 +154,46 @@ void Node::skip_unless(const std::string& channel, std::function<bool(int64_t ut
 }
 
 void Node::subscribe_raw(const std::string& regex, RawHandler handler) {
-  raw_handlers_.emplace_back(regex, std::move(handler));
-  lcm_->subscribe(regex, &Node::on_raw_message, this);
+  std::regex pattern;
+  try {
+    pattern = std::regex(regex, std::regex::extended);
+  } catch (const std::regex_error& e) {
+    throw NodeError("channel pattern '" + regex + "' is not a regular expression: " + e.what());
+  }
+  raw_handlers_.push_back({std::move(pattern), std::move(handler)});
+  if (udpm_) {
+    update_receiver();  // the kernel filter cannot match patterns: everything passes
+  } else if (raw_handlers_.size() == 1) {
+    lcm_->subscribe(".*", &Node::on_lcm_raw_message, this);
+  }
 }
 
-void Node::on_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void Node::never_wanted(std::vector<std::string> channels) {
+  never_wanted_ = std::move(channels);
+  if (receiver_) update_receiver();
+}
+
+void Node::on_lcm_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  on_raw_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+}
+
+void Node::on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size) {
   // Raw subscribers see the bytes as they came; they count nothing as malformed themselves.
-  for (auto& [regex, handler] : raw_handlers_) {
+  for (auto& raw : raw_handlers_) {
+    if (!std::regex_match(channel, raw.pattern)) continue;
     try {
-      handler(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+      raw.handler(channel, data, size);
     } catch (const std::exception& e) {
       note_handler_error(channel, e.what());
     }
   }
 }
 
-void Node::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  const auto* data = static_cast<const uint8_t*>(rbuf->data);
-  const std::size_t size = rbuf->data_size;
+void Node::on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  on_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+}
+
+void Node::on_message(const std::string& channel, const uint8_t* data, std::size_t size) {
   auto& c = incoming_[channel];
   ++c.messages;
   c.bytes += static_cast<int64_t>(size);
@@ -216,7 +267,9 @@ bool Node::publish_raw(const std::string& channel, const void* data, std::size_t
   }
   auto& c = outgoing_[channel];
   c.outgoing = true;
-  if (lcm_->publish(channel, data, static_cast<unsigned int>(size)) != 0) {
+  const bool sent = sender_ ? sender_->publish(channel, static_cast<const uint8_t*>(data), size)
+                            : lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
+  if (!sent) {
     ++c.dropped;
     ++counters_.dropped;
     return false;
@@ -319,9 +372,47 @@ int Node::spin_once(int timeout_ms) {
   if (now >= next_status_) publish_status();
   const auto until_status = std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
+  if (udpm_) return receive_once(wait);
   const int rc = lcm_->handleTimeout(wait);
   if (rc < 0) return shutdown_requested() ? 0 : -1;  // a signal interrupting the wait is not a failure
   return rc > 0 ? 1 : 0;
+}
+
+int Node::receive_once(int wait_ms) {
+  // One message per call, as liblcm's handle() gives: callers check their state between messages.
+  if (!receiver_) {
+    ::poll(nullptr, 0, wait_ms);  // nothing subscribed: nothing can arrive
+    return 0;
+  }
+  LcmMessageView m;
+  bool got = receiver_->next(&m);
+  if (!got && wait_ms > 0 && receiver_->wait(wait_ms)) got = receiver_->next(&m);
+  note_receiver_problems();
+  if (!got) return 0;
+  // liblcm calls a channel's handlers in the order they subscribed; the typed subscription of a
+  // channel comes before any pattern here (SIM_CLOCK is subscribed in the constructor).
+  if (subs_.count(*m.channel)) on_message(*m.channel, m.data, m.size);
+  if (!raw_handlers_.empty()) on_raw_message(*m.channel, m.data, m.size);
+  return 1;
+}
+
+void Node::note_receiver_problems() {
+  const ReassemblyCounters& now = receiver_->counters();
+  const int64_t rejected = now.rejected - receiver_seen_.rejected;
+  const int64_t incomplete = now.incomplete - receiver_seen_.incomplete;
+  if (rejected == 0 && incomplete == 0) return;
+  receiver_seen_ = now;
+  counters_.malformed += rejected;
+  counters_.dropped += incomplete;
+  if (options_.quiet) return;
+  if (rejected > 0 && worth_logging(now.rejected)) {
+    std::cerr << options_.name << ": dropped a datagram that is not LCM's ("
+              << to_string(receiver_->last_error()) << "; " << now.rejected << " so far)\n";
+  }
+  if (incomplete > 0 && worth_logging(now.incomplete)) {
+    std::cerr << options_.name << ": dropped a message whose fragments did not all arrive (" << now.incomplete
+              << " so far)\n";
+  }
 }
 
 int Node::drain() {

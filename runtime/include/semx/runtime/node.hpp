@@ -17,12 +17,15 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "semx/runtime/lcm_schema.hpp"
 #include "semx/runtime/sim_clock.hpp"
+#include "semx/runtime/udpm_receiver.hpp"
+#include "semx/runtime/udpm_sender.hpp"
 #include "semx/runtime/wire_validator.hpp"
 
 namespace semx::runtime {
@@ -58,8 +61,8 @@ struct ChannelCounters {
 struct NodeCounters {
   int64_t received = 0;
   int64_t sent = 0;
-  int64_t dropped = 0;
-  int64_t malformed = 0;
+  int64_t dropped = 0;    // includes messages whose fragments did not all arrive
+  int64_t malformed = 0;  // includes datagrams that are not LCM's (udpm_receiver.hpp)
   int64_t handler_errors = 0;
 };
 
@@ -87,6 +90,10 @@ class Node {
 
   const std::string& name() const { return options_.name; }
   const std::string& url() const { return options_.lcm_url; }
+  // True when this node reads and writes a udpm group itself, with a kernel filter for its
+  // channels (udpm_receiver.hpp, udpm_sender.hpp); false when liblcm does (other providers, or
+  // SEMX_LCM_TRANSPORT=liblcm in the environment).
+  bool own_receiver() const { return udpm_.has_value(); }
 
   // Typed subscription to one channel. `accept` may reject decoded messages whose content is
   // unusable (NaN poses, inconsistent sizes): they count as malformed.
@@ -101,6 +108,9 @@ class Node {
   // Raw bytes of every channel matching `regex` (tools: monitors, recorders).
   using RawHandler = std::function<void(const std::string& channel, const uint8_t* data, std::size_t size)>;
   void subscribe_raw(const std::string& regex, RawHandler handler);
+  // With a pattern subscription every channel reaches this process; these exact channels, which
+  // its handlers ignore anyway (a recorder's exclusions), the kernel may drop before they do.
+  void never_wanted(std::vector<std::string> channels);
 
   template <class T>
   bool publish(const std::string& channel, const T& msg);
@@ -164,17 +174,33 @@ class Node {
   enum class Outcome { kDelivered, kMalformed, kHandlerError };
 
   void ensure_lcm_subscription(const std::string& channel);
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void on_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_lcm_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_message(const std::string& channel, const uint8_t* data, std::size_t size);
+  void on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size);
+  // Own receiver: opens it on the first subscription and keeps its kernel filter current.
+  void update_receiver();
+  int receive_once(int wait_ms);
+  void note_receiver_problems();
   void on_clock_message(const semx::clock_t& msg);
   void note_malformed(const std::string& channel, const std::string& why, std::size_t size);
   void note_handler_error(const std::string& channel, const char* what);
   const LcmStruct& schema_of(const char* type_name) const;
 
   NodeOptions options_;
-  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<lcm::LCM> lcm_;  // other providers only
   std::map<std::string, std::vector<std::unique_ptr<Subscription>>> subs_;
-  std::vector<std::pair<std::string, RawHandler>> raw_handlers_;
+  struct RawSubscription {
+    std::regex pattern;  // a full match, as liblcm anchors its channel regexes
+    RawHandler handler;
+  };
+  std::vector<RawSubscription> raw_handlers_;
+  std::optional<UdpmEndpoint> udpm_;
+  std::unique_ptr<UdpmReceiver> receiver_;
+  std::unique_ptr<UdpmSender> sender_;
+  std::vector<std::string> receive_channels_;
+  std::vector<std::string> never_wanted_;
+  ReassemblyCounters receiver_seen_;  // what the counters already hold of the receiver's
   std::map<std::string, std::function<bool(int64_t)>> skip_filters_;
   std::vector<uint8_t> encode_buffer_;
   std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;

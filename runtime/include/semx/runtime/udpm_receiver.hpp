@@ -1,0 +1,78 @@
+// A node's own reader of an LCM udpm multicast group.
+//
+// liblcm 1.3 reads the group on a thread of its own and hands each message to the main thread
+// through a pipe, and it reads every datagram on the group, also those of channels the process
+// never subscribed to. In a lockstep set every tick's few small messages (clock, odometry,
+// commands, acks) therefore woke every thread of every process. This reader runs on the caller's
+// thread and gives the socket a kernel filter (classic BPF) that drops, before any process wakes,
+// the datagrams of channels it does not read. The bytes on the wire are liblcm's, so lcm-logger,
+// lcm-spy and liblcm processes share the group as before.
+#pragma once
+
+#include <linux/filter.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "semx/runtime/lcm_datagram.hpp"
+
+namespace semx::runtime {
+
+// What "udpm://GROUP:PORT?ttl=N&recv_buf_size=BYTES" names.
+struct UdpmEndpoint {
+  std::string group;
+  int port = 0;
+  int ttl = 0;            // 0: nothing leaves the host
+  int recv_buf_size = 0;  // 0: the kernel's default
+};
+
+// The endpoint of a udpm URL; nullopt for any other provider and for URLs this parser does not
+// understand (liblcm's own receiver then takes them as before).
+std::optional<UdpmEndpoint> parse_udpm_url(const std::string& url);
+
+// A classic BPF program for a UDP socket (offset 0 is the UDP header) that passes the LCM
+// datagrams of `channels` (exact names) and drops the rest, or, with `refuse`, drops those of
+// `channels` and passes the rest. Fragments after the first name no channel: one whose sequence
+// number carries a channel tag (udpm_sender.hpp) is judged by the tag, an untagged one (liblcm's
+// senders) always passes; the reassembler drops those whose first fragment was refused.
+std::vector<sock_filter> lcm_channel_filter(const std::vector<std::string>& channels, bool refuse = false);
+
+class UdpmReceiver {
+ public:
+  // Opens, filters (nothing passes until filter() is called), binds and joins the group. Throws
+  // std::runtime_error naming the endpoint and the failing call.
+  UdpmReceiver(const UdpmEndpoint& endpoint, std::size_t max_message_bytes);
+  ~UdpmReceiver();
+  UdpmReceiver(const UdpmReceiver&) = delete;
+  UdpmReceiver& operator=(const UdpmReceiver&) = delete;
+
+  // The channels the kernel lets through: exactly `channels`; or, when `all`, every channel but
+  // `refused` (a hint: channels it does not drop are still refused by the caller).
+  void filter(const std::vector<std::string>& channels, bool all,
+              const std::vector<std::string>& refused = {});
+
+  // The next complete message from the datagrams queued now, without waiting; false when none
+  // completes. The view is valid until the next call. A bad datagram is counted and skipped, and
+  // its reason left in last_error().
+  bool next(LcmMessageView* out);
+  // Waits up to timeout_ms for a datagram; false on timeout or a signal.
+  bool wait(int timeout_ms) const;
+
+  int fd() const { return fd_; }
+  const ReassemblyCounters& counters() const { return reassembler_.counters(); }
+  DatagramError last_error() const { return last_error_; }
+  int64_t socket_errors() const { return socket_errors_; }
+
+ private:
+  int fd_ = -1;
+  std::vector<uint8_t> buffer_;
+  LcmReassembler reassembler_;
+  DatagramError last_error_ = DatagramError::kNone;
+  int64_t socket_errors_ = 0;
+  std::string name_;
+};
+
+}  // namespace semx::runtime

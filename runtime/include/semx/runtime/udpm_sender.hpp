@@ -1,0 +1,53 @@
+// Publishes on an LCM udpm group in liblcm's wire format (lcm_datagram.hpp), with one addition
+// the format leaves room for: the sequence number, which receivers only use to tell a sender's
+// messages apart, carries a tag of the channel. Fragments after the first name no channel, so
+// without the tag a kernel filter (udpm_receiver.hpp) could not drop them, and every process
+// received every fragment of every camera frame and ESDF window.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "semx/runtime/udpm_receiver.hpp"
+
+namespace semx::runtime {
+
+// seqno = kSeqnoTagged | tag << 8 | counter: liblcm's senders count from 0 and reach the marker
+// only after 2^32 - 2^28 messages, so their fragments stay untagged and always pass the filter.
+// A receiver only compares a sender's seqnos for equality, and one sender's consecutive messages
+// differ in the counter or the tag.
+inline constexpr uint32_t kSeqnoTagMask = 0xF0000000u;
+inline constexpr uint32_t kSeqnoTagged = 0xF0000000u;
+inline constexpr int kSeqnoTagShift = 8;
+inline constexpr uint32_t kSeqnoTagBits = 0xFFFFFu;
+// A 20-bit hash of the name, never 0. Two channels with one tag would let each other's later
+// fragments through a filter that wants one of them, or drop them in one that refuses one of
+// them (semx's own channels have distinct tags, a test checks).
+uint32_t channel_tag(const std::string& channel);
+
+class UdpmSender {
+ public:
+  // Throws std::runtime_error naming the endpoint and the failing call.
+  explicit UdpmSender(const UdpmEndpoint& endpoint);
+  ~UdpmSender();
+  UdpmSender(const UdpmSender&) = delete;
+  UdpmSender& operator=(const UdpmSender&) = delete;
+
+  // Sends one message as one datagram or as fragments; false when the name is not a channel
+  // liblcm could carry or the kernel refused a datagram.
+  bool publish(const std::string& channel, const uint8_t* data, std::size_t size);
+
+  // The largest datagram this sender writes (liblcm reads up to 64 KiB).
+  static constexpr std::size_t kMaxDatagram = 65000;
+
+ private:
+  int fd_ = -1;
+  std::vector<uint8_t> header_;
+  uint8_t counter_ = 0;
+  uint32_t group_ = 0;  // network order
+  uint16_t port_ = 0;   // network order
+};
+
+}  // namespace semx::runtime
