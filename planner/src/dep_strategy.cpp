@@ -386,11 +386,36 @@ void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
   ctx.counters->gain_ms += w.ms();
 }
 
-double DepStrategy::score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const {
+DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, int64_t id, bool sweep) const {
   const RoadmapNode& n = graph_.node(id);
   const double reward = reward_at(ctx, n.position);
-  return score(n.gain.gain, reward, search_.distance[static_cast<size_t>(id)],
-               yaw_distance(ctx.pose.yaw, n.gain.yaw));
+  const double d = search_.distance[static_cast<size_t>(id)];
+  View v{n.gain.yaw, n.gain.gain, score(n.gain.gain, reward, d, yaw_distance(ctx.pose.yaw, n.gain.yaw))};
+  if (!sweep) return v;
+  // The camera sees while it turns (the controller turns on the way, travel_cost.hpp): a turn is
+  // worth what it sweeps, and the yaw that sweeps the most per second of flight is the node's.
+  // Gains are the node's, an approximation of what is seen from the path's positions. Among equal
+  // scores the turn ends at the window that sees the most (so the vehicle arrives looking at what
+  // it came for, and what is left there is what the visit marks unobservable), then the smaller
+  // turn.
+  gains_.sweep_gains(n.gain, ctx.pose.yaw, sweeps_);
+  double best_window = -1.0, best_turn = 0.0;
+  v.score = -1.0;
+  for (int j = 0; j < gains_.bins(); ++j) {
+    const double yaw = gains_.window_yaw(j);
+    const double turn = yaw_distance(ctx.pose.yaw, yaw);
+    const double g = sweeps_[static_cast<size_t>(j)];
+    const double s = score(g, reward, d, turn);
+    const double window = gains_.gain_at_yaw(n.gain, yaw);
+    const bool tie = s > v.score - 1e-9 * std::max(1.0, v.score);
+    if (s > v.score + 1e-9 * std::max(1.0, v.score) ||
+        (tie && (window > best_window + 1e-9 || (window > best_window - 1e-9 && turn < best_turn - 1e-9)))) {
+      v = {yaw, g, s};
+      best_window = window;
+      best_turn = turn;
+    }
+  }
+  return v;
 }
 
 double DepStrategy::reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const {
@@ -432,23 +457,22 @@ void DepStrategy::update_region_factors(PlanContext& ctx) {
   }
 }
 
-bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id) const {
-  const RoadmapNode& n = graph_.node(id);
+bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id, double yaw) const {
   return search_.distance[static_cast<size_t>(id)] < config_.loop.goal_tolerance &&
-         yaw_distance(ctx.pose.yaw, n.gain.yaw) < config_.loop.yaw_tolerance;
+         yaw_distance(ctx.pose.yaw, yaw) < config_.loop.yaw_tolerance;
 }
 
 DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t id) const {
   FlownPath f;
   const std::vector<int64_t> path = Roadmap::path_to(search_, id);
   for (int64_t p : path) f.waypoints.push_back(graph_.node(p).position);
-  f.yaws = interpolate_yaws(f.waypoints, ctx.pose.yaw, graph_.node(id).gain.yaw);
+  f.yaws = interpolate_yaws(f.waypoints, ctx.pose.yaw, yaw_[static_cast<size_t>(id)]);
   f.held = hold_heading_through_doorways(path, f.waypoints, f.yaws);
   return f;
 }
 
-Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                              int64_t* unreachable) {
+Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason, int64_t* unreachable,
+                              bool sweep) {
   {
     Stopwatch w;
     search_ = graph_.shortest_paths(root_);
@@ -460,6 +484,17 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   reward_.assign(slots, 0.0);
   cost_.assign(slots, -1.0);
   score_.assign(slots, 0.0);
+  yaw_.assign(slots, 0.0);
+  view_gain_.assign(slots, 0.0);
+  // Scores the node at its view (yaw, gain) and keeps them per slot.
+  auto rate = [&](int64_t id) {
+    const View v = view_of(ctx, score, id, sweep);
+    const size_t i = static_cast<size_t>(id);
+    yaw_[i] = v.yaw;
+    view_gain_[i] = v.gain;
+    score_[i] = v.score;
+    cost_[i] = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
+  };
 
   using Item = std::pair<double, int64_t>;  // (score, -id): ties go to the lower id
   std::priority_queue<Item> queue;
@@ -470,13 +505,10 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ++reachable;
     if (!n.gain.valid) evaluate_gain(ctx, n.id);
     const RoadmapNode& m = graph_.node(n.id);
-    const double reward = reward_at(ctx, m.position);
-    reward_[static_cast<size_t>(n.id)] = reward;
-    cost_[static_cast<size_t>(n.id)] =
-        travel_time(search_.distance[static_cast<size_t>(n.id)], ctx.pose.yaw, m.gain.yaw, config_.cost);
-    score_[static_cast<size_t>(n.id)] = score_of(ctx, score, n.id);
+    reward_[static_cast<size_t>(n.id)] = reward_at(ctx, m.position);
+    rate(n.id);
     if (m.blacklisted_until >= ctx.cycle || m.passage) continue;
-    if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id)) continue;
+    if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id, yaw_[static_cast<size_t>(n.id)])) continue;
     queue.emplace(score_[static_cast<size_t>(n.id)], -n.id);
   }
   Goal goal;
@@ -500,7 +532,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
         double turn = yaw_distance(ctx.pose.yaw, f->yaws.front());
         for (size_t i = 1; i < f->yaws.size(); ++i) turn += yaw_distance(f->yaws[i - 1], f->yaws[i]);
         const size_t i = static_cast<size_t>(id);
-        const double flown = score(n.gain.gain, reward_[i], search_.distance[i], turn);
+        const double flown = score(view_gain_[i], reward_[i], search_.distance[i], turn);
         if (flown < score_[i] - 1e-9) {
           score_[i] = flown;
           cost_[i] = travel_time(search_.distance[i], turn, config_.cost);
@@ -511,18 +543,16 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     }
     if (n.gain_stale) {
       evaluate_gain(ctx, id);
-      const double s = score_of(ctx, score, id);
-      score_[static_cast<size_t>(id)] = s;
-      cost_[static_cast<size_t>(id)] =
-          travel_time(search_.distance[static_cast<size_t>(id)], ctx.pose.yaw, n.gain.yaw, config_.cost);
-      if (n.gain.gain >= min_gain && !nothing_to_do(ctx, id)) queue.emplace(s, -id);
+      rate(id);
+      const size_t i = static_cast<size_t>(id);
+      if (n.gain.gain >= min_gain && !nothing_to_do(ctx, id, yaw_[i])) queue.emplace(score_[i], -id);
       continue;
     }
     goal.valid = true;
     goal.node = id;
     goal.position = n.position;
-    goal.yaw = n.gain.yaw;
-    goal.gain = n.gain.gain;
+    goal.yaw = yaw_[static_cast<size_t>(id)];
+    goal.gain = view_gain_[static_cast<size_t>(id)];
     goal.reward = reward_[static_cast<size_t>(id)];
     goal.cost = cost_[static_cast<size_t>(id)];
     goal.score = score_[static_cast<size_t>(id)];
@@ -563,7 +593,7 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   bridge(ctx);
 
   PlanOutcome out;
-  out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative);
+  out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep);
   ctx.counters->box_checks += checker_.box_checks();
   checker_.reset_counters();
   return out;
@@ -605,8 +635,10 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   if (n.gain_stale || !n.gain.valid) evaluate_gain(ctx, goal.node);
   if (n.gain.gain < config_.gain.min_gain) return std::nullopt;
   const double reward = reward_at(ctx, n.position);
-  // The goal keeps the yaw it was chosen with (its best yaw may have moved since).
-  const double g = gains_.gain_at_yaw(n.gain, goal.yaw);
+  // The goal keeps the yaw it was chosen with (its best yaw may have moved since); with the sweep
+  // it is worth what the rest of the turn to that yaw sweeps.
+  const double g = config_.gain.sweep ? gains_.sweep_gain(n.gain, ctx.pose.yaw, gains_.window_of(goal.yaw))
+                                      : gains_.gain_at_yaw(n.gain, goal.yaw);
   return node_score(
       g, reward,
       travel_time(search_.distance[static_cast<size_t>(goal.node)], ctx.pose.yaw, goal.yaw, config_.cost));

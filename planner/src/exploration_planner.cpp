@@ -128,6 +128,11 @@ bool ExplorationPlanner::held_short(int64_t utime) {
   return utime - short_since_ >= static_cast<int64_t>(std::llround(config_.loop.short_hold_s * 1e6));
 }
 
+void ExplorationPlanner::add_unobservable(const std::vector<mapper::VoxelKey>& keys) {
+  for (const mapper::VoxelKey& k : keys) unobservable_.insert(k);
+  if (strategy_ && !keys.empty()) strategy_->on_gain_invalidated(keys);
+}
+
 void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
   if (!grid_ || !pose_) return;
   Stopwatch w;

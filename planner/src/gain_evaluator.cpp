@@ -157,6 +157,34 @@ double GainEvaluator::gain_at_yaw(const NodeGain& g, double yaw) const {
   return s;
 }
 
+void GainEvaluator::sweep_gains(const NodeGain& g, double from_yaw, std::vector<double>& out) const {
+  const int bins = config_.yaw_bins;
+  out.assign(static_cast<size_t>(bins), 0.0);
+  if (!g.valid) return;
+  // prefix[k] = bins [0, k) over two laps, so any circular run is one difference.
+  std::vector<double>& prefix = sweep_prefix_;
+  prefix.assign(static_cast<size_t>(2 * bins + 1), 0.0);
+  for (int k = 0; k < 2 * bins; ++k)
+    prefix[static_cast<size_t>(k + 1)] = prefix[static_cast<size_t>(k)] + g.bin_gain[static_cast<size_t>(k % bins)];
+  const int from = window_of(from_yaw);
+  for (int j = 0; j < bins; ++j) {
+    // Counter-clockwise (increasing bins) from `from` to j, or clockwise from j to `from`; at a
+    // half turn either way, as the path's yaws take it (wrap_angle).
+    const bool ccw = wrap_angle(window_yaw(j) - window_yaw(from)) >= 0.0;
+    const int start = ccw ? from : j;
+    const int span = std::min(bins, ((ccw ? j - from : from - j) % bins + bins) % bins + window_);
+    out[static_cast<size_t>(j)] =
+        prefix[static_cast<size_t>(start + span)] - prefix[static_cast<size_t>(start)];
+  }
+}
+
+double GainEvaluator::sweep_gain(const NodeGain& g, double from_yaw, int to_window) const {
+  std::vector<double> all;
+  sweep_gains(g, from_yaw, all);
+  const int bins = config_.yaw_bins;
+  return all.empty() ? 0.0 : all[static_cast<size_t>(((to_window % bins) + bins) % bins)];
+}
+
 void GainEvaluator::prepare(double res) {
   seen_res_ = res;
   const double reach = config_.max_range + res;

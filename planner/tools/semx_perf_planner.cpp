@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
     std::string world_name = "apartment", planner_name, config_file;
     int64_t samples = 0, seed = -1, runs = 1;
     double max_time = 900.0, semantic_weight = 0.0;
-    bool fit = false, verbose = false, kernels = false;
+    bool fit = false, verbose = false, kernels = false, oracle = false;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
@@ -169,6 +169,7 @@ int main(int argc, char** argv) {
         .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
         .flag("fit", "print least-squares charge coefficients", &fit)
         .flag("verbose", "one line per cycle", &verbose)
+        .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start", &oracle)
         .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels);
     if (!p.parse(argc, argv)) return 0;
     if (!planner_name.empty()) overrides.push_back("planner=" + planner_name);
@@ -192,6 +193,24 @@ int main(int argc, char** argv) {
       o.max_time = max_time;
       o.semantic_weight = semantic_weight;
       o.coverage_period = 1.0;
+      if (oracle) {
+        std::vector<semx::mapper::VoxelKey> keys;
+        const double r = world->resolution();
+        for (const Box& b : world->objects()) {
+          const semx::mapper::KeyMath km(r);
+          const auto lo = km.key(b.min), hi = km.key(b.max);
+          for (int32_t x = lo.x; x <= hi.x; ++x)
+            for (int32_t y = lo.y; y <= hi.y; ++y)
+              for (int32_t z = lo.z; z <= hi.z; ++z) {
+                const semx::mapper::VoxelKey k{x, y, z};
+                const Eigen::Vector3d c = km.center(k);
+                if (((c - b.min).array() > r).all() && ((b.max - c).array() > r).all() && world->occupied(k))
+                  keys.push_back(k);
+              }
+        }
+        planner.add_unobservable(keys);
+        if (run == 0) std::printf("oracle_interior_voxels: %zu\n", keys.size());
+      }
       ExplorationSim sim(*world, planner, o);
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
         if (verbose && out.status && out.status->iteration > 0) {
@@ -223,6 +242,7 @@ int main(int argc, char** argv) {
         objects_time += r.objects_time;
         ++objects_done;
       }
+      std::printf("run_time_to_85: %.1f s\n", r.time_85);
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
         ++reached_85;

@@ -165,6 +165,38 @@ TEST(Gain, YawBinsPickTheRichestWindow) {
   }
 }
 
+TEST(Gain, ATurnSweepsEveryWindowItPassesTheShorterWay) {
+  GainEvaluator e(GainConfig{});
+  const int bins = e.bins(), w = e.window_bins();
+  ASSERT_EQ(bins, 32);
+  NodeGain g;
+  g.bin_gain.assign(static_cast<size_t>(bins), 0.0f);
+  g.bin_count.assign(static_cast<size_t>(bins), {0, 0, 0});
+  for (int b = 0; b < bins; ++b) g.bin_gain[static_cast<size_t>(b)] = static_cast<float>(1 << (b % 8)) + b;
+  e.finish(g);
+  auto bins_sum = [&](int from, int count) {
+    double s = 0;
+    for (int k = 0; k < count; ++k) s += g.bin_gain[static_cast<size_t>((from + k) % bins)];
+    return s;
+  };
+  std::vector<double> sweep;
+  const int from = 4;  // the window the vehicle looks through: bins 4..11
+  e.sweep_gains(g, e.window_yaw(from), sweep);
+  ASSERT_EQ(sweep.size(), 32u);
+  // No turn: that window. Counter-clockwise to window 10: bins 4..17. Clockwise to window 30
+  // (6 bins the other way): bins 30..11. Half a turn (window 20): the way wrap_angle gives.
+  EXPECT_DOUBLE_EQ(sweep[4], bins_sum(4, w));
+  EXPECT_DOUBLE_EQ(sweep[10], bins_sum(4, 6 + w));
+  EXPECT_DOUBLE_EQ(sweep[30], bins_sum(30, 6 + w));
+  const bool ccw = wrap_angle(e.window_yaw(20) - e.window_yaw(4)) >= 0;
+  EXPECT_DOUBLE_EQ(sweep[20], ccw ? bins_sum(4, 16 + w) : bins_sum(20, 16 + w));
+  for (int j = 0; j < bins; ++j) {
+    EXPECT_DOUBLE_EQ(e.sweep_gain(g, e.window_yaw(from), j), sweep[static_cast<size_t>(j)]);
+    EXPECT_GE(sweep[static_cast<size_t>(j)], e.gain_at_yaw(g, e.window_yaw(j)) - 1e-9);  // never less than the window
+    EXPECT_LE(sweep[static_cast<size_t>(j)], bins_sum(0, bins) + 1e-9);                 // each bin once
+  }
+}
+
 TEST(Gain, BinOfAzimuthAgreesWithAtan2) {
   GainEvaluator e(GainConfig{});
   for (int i = 0; i < 3600; ++i) {

@@ -94,9 +94,11 @@ class DepStrategy : public Strategy {
   int relink(PlanContext& ctx, const Roadmap::Search& reach);
   // Steps 4-6 with a given score of (gain, reward, path length, yaw change); returns the goal.
   using ScoreFn = std::function<double(double gain, double reward, double distance, double yaw_change)>;
-  // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach.
-  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                   int64_t* unreachable = nullptr);
+  // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach. With
+  // `sweep` a node is scored at the yaw whose turn from the vehicle's heading, counting what it
+  // sweeps, scores best (GainConfig::sweep); otherwise at its best window.
+  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason, int64_t* unreachable = nullptr,
+                   bool sweep = false);
   // The paper's score (G + R_sem) / T_path (travel_cost.hpp).
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);
@@ -108,7 +110,13 @@ class DepStrategy : public Strategy {
   GainEvaluator& gains() { return gains_; }
 
  private:
-  double score_of(PlanContext& ctx, const ScoreFn& score, int64_t id) const;
+  // What a node is scored with: a yaw, the gain counted for it, and the score.
+  struct View {
+    double yaw = 0.0;
+    double gain = 0.0;
+    double score = 0.0;
+  };
+  View view_of(PlanContext& ctx, const ScoreFn& score, int64_t id, bool sweep) const;
   // R_sem at p with this cycle's region factors (0 for plain DEP).
   double reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const;
   // Each region's 1 + κ U_i (config reward.unexplored_weight), or a door's a_i + κ_p U_i
@@ -116,7 +124,7 @@ class DepStrategy : public Strategy {
   void update_region_factors(PlanContext& ctx);
   // Some voxel of obstacle_voxels_ has its centre within `radius` of the segment a-b.
   bool obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double res) const;
-  bool nothing_to_do(PlanContext& ctx, int64_t id) const;
+  bool nothing_to_do(PlanContext& ctx, int64_t id, double yaw) const;
 
   PlannerConfig config_;
   bool semantic_;
@@ -132,7 +140,8 @@ class DepStrategy : public Strategy {
   bool full_reset_ = false;
   // The last cycle's search and per-slot values, for goal_score() and the roadmap view.
   Roadmap::Search search_;
-  std::vector<double> reward_, cost_, score_;
+  std::vector<double> reward_, cost_, score_, yaw_, view_gain_;
+  mutable std::vector<double> sweeps_;  // scratch: one node's sweep gains
   std::vector<double> region_factor_;  // one per region of ctx.regions this cycle
   // ctx.regions with the doors active when passage_weight is on (their factor says how much).
   std::vector<SemanticRegion> cycle_regions_;

@@ -88,6 +88,8 @@ class ExplorationPlanner {
   const StatusReport& last_status() const { return last_status_; }
   const FrontierTracker& frontiers() const { return frontiers_; }
   const VoxelSet& unobservable() const { return unobservable_; }
+  // Voxels no gain should count from now on (known to be unobservable by other means).
+  void add_unobservable(const std::vector<mapper::VoxelKey>& keys);
   Strategy& strategy() { return *strategy_; }
   const std::vector<SemanticRegion>& regions() const { return regions_; }
 

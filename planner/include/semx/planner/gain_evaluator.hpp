@@ -89,6 +89,11 @@ class GainEvaluator {
   void finish(NodeGain& g) const;
   // Gain of the window centred nearest to `yaw`.
   double gain_at_yaw(const NodeGain& g, double yaw) const;
+  // What a camera turning at the node from `from_yaw` to the window starting at bin `to_window`,
+  // the shorter way, sees: every bin of every window it passes, each once (all bins when the
+  // turn and the window together span them). sweep_gains() fills this for every window at once.
+  double sweep_gain(const NodeGain& g, double from_yaw, int to_window) const;
+  void sweep_gains(const NodeGain& g, double from_yaw, std::vector<double>& out) const;
 
  private:
   bool in_sector(const Eigen::Vector3d& offset) const;
@@ -115,6 +120,7 @@ class GainEvaluator {
   // The blocks around the node's, looked up in this evaluation (block_stamp_ == stamp_).
   std::vector<const mapper::VoxelBlock*> block_ptr_;
   std::vector<const VoxelSet::Mask*> ignored_ptr_;  // the ignored voxels of the same blocks
+  mutable std::vector<double> sweep_prefix_;
   std::vector<uint32_t> block_stamp_;
   uint32_t stamp_ = 0;
   int block_lo_ = 0, block_lo_z_ = 0, block_n_ = 0;

@@ -102,6 +102,11 @@ struct GainConfig {
   int rays_azimuth = 128;   // gain rays around the node (a multiple of yaw_bins)
   int rays_elevation = 10;  // rays across the vertical field of view
   double min_gain = 1000.0;  // a node with G below this is not a goal (weighted voxels)
+  // An ablation (docs/planner.md, "Gain"): DEP's score counts what the turn to a node's yaw
+  // sweeps, not only the final window, and takes the yaw that scores best that way. false (the
+  // default): the best window's gain and yaw, DEP's definition. Eligibility (min_gain) and
+  // termination use the best window either way.
+  bool sweep = false;
 
   double horizontal_fov() const;  // rad
   double vertical_fov() const;    // rad
