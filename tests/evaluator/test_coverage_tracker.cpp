@@ -129,5 +129,43 @@ TEST(CoverageTracker, CountsOnlyTargetVoxels) {
   EXPECT_EQ(tracker.covered(), 0);
 }
 
+TEST(CoverageTracker, ObjectCoverageCountsTheFurnituresSurfaceOnly) {
+  const auto gt = small_gt();
+  CoverageTracker tracker(gt);
+  ASSERT_EQ(gt->objects().size(), 1u);  // the table
+  const simulator::ObjectInfo& table = gt->objects().front();
+  const Eigen::Vector3d lo = table.center - 0.5 * table.extent, hi = table.center + 0.5 * table.extent;
+  // Brute force: occupied target voxels whose cube overlaps the table's box with some volume.
+  int64_t expected = 0;
+  std::vector<mapper::VoxelKey> table_voxels;
+  const Eigen::Vector3i k0 = gt->min_key(), d = gt->dims();
+  for (int z = 0; z < d.z(); ++z)
+    for (int y = 0; y < d.y(); ++y)
+      for (int x = 0; x < d.x(); ++x) {
+        const Eigen::Vector3i k = k0 + Eigen::Vector3i(x, y, z);
+        const Eigen::Vector3d a = k.cast<double>() * 0.1, b = a + Eigen::Vector3d::Constant(0.1);
+        const bool overlaps = ((a.array() < hi.array() - 1e-9) && (b.array() > lo.array() + 1e-9)).all();
+        if (!overlaps || !gt->in_target(k) || gt->cell(k) != simulator::GroundTruth::kOccupied) continue;
+        ++expected;
+        table_voxels.emplace_back(k.x(), k.y(), k.z());
+      }
+  ASSERT_GT(expected, 50);  // the table's top and sides
+  EXPECT_EQ(tracker.object_target_count(), expected);
+  EXPECT_EQ(tracker.object_coverage(), 0.0);
+  // A wall voxel in T counts for coverage, not for the objects; a table voxel for both.
+  const Eigen::Vector3i wall = gt->key_of({1.5, -0.05, 0.8});
+  ASSERT_TRUE(gt->in_target(wall));
+  tracker.set({wall.x(), wall.y(), wall.z()}, mapper::VoxelState::kOccupied);
+  EXPECT_EQ(tracker.covered(), 1);
+  EXPECT_EQ(tracker.object_covered(), 0);
+  for (const auto& k : table_voxels) tracker.set(k, mapper::VoxelState::kOccupied);
+  EXPECT_EQ(tracker.object_covered(), expected);
+  EXPECT_DOUBLE_EQ(tracker.object_coverage(), 1.0);
+  tracker.set(table_voxels.front(), mapper::VoxelState::kUnknown);
+  EXPECT_EQ(tracker.object_covered(), expected - 1);
+  tracker.clear();
+  EXPECT_EQ(tracker.object_covered(), 0);
+}
+
 }  // namespace
 }  // namespace semx::evaluator

@@ -55,6 +55,23 @@ TEST(RunMetrics, CustomThreshold) {
   EXPECT_DOUBLE_EQ(*m.time_r_s(), 3.0);
 }
 
+TEST(RunMetrics, TimeOIsTheFirstUpdateWithTheObjectsAt75Percent) {
+  RunMetrics m;
+  m.on_object_coverage(1000000, 70, 100);
+  EXPECT_FALSE(m.time_o_s());
+  EXPECT_DOUBLE_EQ(m.object_coverage_pct(), 70.0);
+  m.on_object_coverage(2000000, 75, 100);
+  m.on_object_coverage(3000000, 90, 100);
+  ASSERT_TRUE(m.time_o_s());
+  EXPECT_DOUBLE_EQ(*m.time_o_s(), 2.0);
+  EXPECT_DOUBLE_EQ(m.object_coverage_pct(), 90.0);
+  EXPECT_FALSE(m.time_r_s());  // the volume's threshold is the volume's
+  RunMetrics none;
+  none.on_object_coverage(1000000, 0, 0);  // a world without objects
+  EXPECT_FALSE(none.time_o_s());
+  EXPECT_DOUBLE_EQ(none.object_coverage_pct(), 0.0);
+}
+
 TEST(RunMetrics, DistanceIsIntegratedFromOdometry) {
   RunMetrics m;
   // A 2 x 1 m rectangle at 100 Hz, 1 cm per step: 6 m; then a duplicate, an old and a NaN message.

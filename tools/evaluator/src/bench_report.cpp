@@ -62,11 +62,12 @@ struct Group {
     for (const auto* r : runs) v.push_back(r->*field);
     return stat_of(v);
   }
-  // Time_r over the runs that reached the threshold; `reached` of `runs.size()` did.
-  Stat time_r(int* reached) const {
+  // Time_r (or another optional time) over the runs that reached its threshold; `reached` of
+  // `runs.size()` did.
+  Stat time_r(int* reached, std::optional<double> BenchRun::*field = &BenchRun::time_r_s) const {
     std::vector<double> v;
     for (const auto* r : runs)
-      if (r->time_r_s) v.push_back(*r->time_r_s);
+      if (r->*field) v.push_back(*(r->*field));
     *reached = static_cast<int>(v.size());
     return stat_of(v);
   }
@@ -77,9 +78,9 @@ struct Group {
   }
 };
 
-std::string time_r_cell(const Group& g) {
+std::string time_r_cell(const Group& g, std::optional<double> BenchRun::*field = &BenchRun::time_r_s) {
   int reached = 0;
-  const Stat s = g.time_r(&reached);
+  const Stat s = g.time_r(&reached, field);
   if (reached == 0) return "N/A";
   std::string cell = pm(s);
   if (reached < static_cast<int>(g.runs.size()))
@@ -157,6 +158,9 @@ BenchRun load_bench_run(const std::string& dir) {
   r.sim_s = m["sim_s"] && !m["sim_s"].IsNull() ? m["sim_s"].as<double>() : r.time_f_s;
   r.collisions = static_cast<int64_t>(number_of(m, "collisions", file));
   if (m["time_r_s"] && !m["time_r_s"].IsNull()) r.time_r_s = m["time_r_s"].as<double>();
+  if (m["time_o_s"] && !m["time_o_s"].IsNull()) r.time_o_s = number_of(m, "time_o_s", file);
+  if (m["object_coverage_pct"] && !m["object_coverage_pct"].IsNull())
+    r.object_coverage_pct = number_of(m, "object_coverage_pct", file);
 
   const std::string csv = (fs::path(dir) / "coverage.csv").string();
   std::ifstream in(csv);
@@ -210,8 +214,9 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
   }
 
   md << "\n### Planners at " << o.comparison_samples << " samples, mean ± std over seeds\n\n"
-     << "| Env. | Algorithm | seeds | Time_f (s) | Distance (m) | Coverage (%) | Time_r (s) | collisions |\n"
-     << "|---|---|---|---|---|---|---|---|\n";
+     << "| Env. | Algorithm | seeds | Time_f (s) | Distance (m) | Coverage (%) | Time_r (s) | collisions | "
+        "Time_o (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& w : worlds) {
     std::vector<const BenchRun*> here;
     for (const auto& r : runs)
@@ -220,13 +225,15 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       const Group g = select(runs, w, p, o.comparison_samples);
       md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
          << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
-         << " | " << time_r_cell(g) << " | " << g.collisions() << " |\n";
+         << " | " << time_r_cell(g) << " | " << g.collisions() << " | " << time_r_cell(g, &BenchRun::time_o_s)
+         << " |\n";
     }
   }
 
   md << "\n### " << o.sweep_planner << " against each baseline (difference of the means; negative time and "
      << "distance are better)\n\n"
-     << "| Env. | vs | Time_f | Time_r | Distance | Coverage (points) |\n|---|---|---|---|---|---|\n";
+     << "| Env. | vs | Time_f | Time_r | Time_o | Distance | Coverage (points) "
+        "|\n|---|---|---|---|---|---|---|\n";
   auto pct = [](double ours, double theirs) {
     if (!(std::fabs(theirs) > 1e-9)) return std::string("–");
     const double d = 100.0 * (ours - theirs) / theirs;
@@ -241,17 +248,21 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
     for (const auto& p : planners_of(here)) {
       if (p == o.sweep_planner) continue;
       const Group theirs = select(runs, w, p, o.comparison_samples);
-      int ro = 0, rt = 0;
-      const Stat tro = ours.time_r(&ro), trt = theirs.time_r(&rt);
-      const std::string time_r = ro == 0 || rt == 0 ? (ro > 0   ? "only ours reached 85 %"
-                                                       : rt > 0 ? "only theirs reached 85 %"
-                                                                : "–")
-                                                    : pct(tro.mean, trt.mean);
+      auto margin = [&](std::optional<double> BenchRun::*field, const char* threshold) {
+        int ro = 0, rt = 0;
+        const Stat so = ours.time_r(&ro, field), st = theirs.time_r(&rt, field);
+        if (ro > 0 && rt > 0) return pct(so.mean, st.mean);
+        return ro > 0   ? "only ours reached " + std::string(threshold)
+               : rt > 0 ? "only theirs reached " + std::string(threshold)
+                        : std::string("–");
+      };
+      const std::string time_r = margin(&BenchRun::time_r_s, "85 %");
+      const std::string time_o = margin(&BenchRun::time_o_s, "75 %");
       const double dc =
           ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
       md << "| " << w << " | " << p << " | "
          << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean) << " | "
-         << time_r << " | "
+         << time_r << " | " << time_o << " | "
          << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
          << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
     }
@@ -270,12 +281,14 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
 std::string bench_csv(const std::vector<BenchRun>& runs) {
   std::ostringstream c;
   c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-       "termination,dir\n";
+       "termination,dir,object_coverage_pct,time_o_s\n";
   for (const auto& r : runs) {
     c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
       << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
       << (r.time_r_s ? fmt(*r.time_r_s, 3) : std::string()) << ',' << r.collisions << ',' << fmt(r.wall_s, 2)
-      << ',' << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << '\n';
+      << ',' << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << ','
+      << (r.object_coverage_pct ? fmt(*r.object_coverage_pct, 3) : std::string()) << ','
+      << (r.time_o_s ? fmt(*r.time_o_s, 3) : std::string()) << '\n';
   }
   return c.str();
 }

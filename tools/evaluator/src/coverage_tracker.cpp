@@ -15,6 +15,33 @@ Eigen::Vector3i to_eigen(const mapper::VoxelKey& k) { return {k.x, k.y, k.z}; }
 CoverageTracker::CoverageTracker(std::shared_ptr<const simulator::GroundTruth> gt) : gt_(std::move(gt)) {
   if (!gt_) throw std::invalid_argument("CoverageTracker: no ground truth");
   known_.assign(gt_->target().size(), 0);
+  object_.assign(gt_->target().size(), 0);
+  // A voxel whose cube overlaps the box has its centre less than half a voxel outside it; one
+  // that only touches a face (the floor under a table) is exactly half a voxel out: excluded.
+  const double half = 0.5 * gt_->resolution() - 1e-6;
+  for (const simulator::ObjectInfo& o : gt_->objects()) {
+    const Eigen::Vector3d lo = o.center - 0.5 * o.extent - Eigen::Vector3d::Constant(half);
+    const Eigen::Vector3d hi = o.center + 0.5 * o.extent + Eigen::Vector3d::Constant(half);
+    const Eigen::Vector3i a = gt_->key_of(lo), b = gt_->key_of(hi);
+    for (int z = a.z(); z <= b.z(); ++z)
+      for (int y = a.y(); y <= b.y(); ++y)
+        for (int x = a.x(); x <= b.x(); ++x) {
+          const Eigen::Vector3i k(x, y, z);
+          if (!gt_->in_grid(k)) continue;
+          const size_t i = gt_->index(k);
+          const Eigen::Vector3d c = gt_->center_of(k);
+          if (!gt_->target()[i] || gt_->cells()[i] != simulator::GroundTruth::kOccupied || object_[i] ||
+              (c.array() < lo.array()).any() || (c.array() > hi.array()).any())
+            continue;
+          object_[i] = 1;
+          ++object_target_;
+        }
+  }
+}
+
+double CoverageTracker::object_coverage() const {
+  return object_target_ > 0 ? static_cast<double>(object_covered_) / static_cast<double>(object_target_)
+                            : 0.0;
 }
 
 bool CoverageTracker::matches(double resolution) const {
@@ -36,6 +63,7 @@ void CoverageTracker::set(const mapper::VoxelKey& key, mapper::VoxelState state)
   if (known_[i] == now) return;
   known_[i] = now;
   covered_ += now ? 1 : -1;
+  if (object_[i]) object_covered_ += now ? 1 : -1;
 }
 
 bool CoverageTracker::apply(const mapper::MapDelta& delta) {
@@ -61,6 +89,7 @@ bool CoverageTracker::reset(const mapper::StateGrid& grid) {
 void CoverageTracker::clear() {
   std::fill(known_.begin(), known_.end(), 0);
   covered_ = 0;
+  object_covered_ = 0;
 }
 
 bool CoverageTracker::known(const mapper::VoxelKey& key) const {

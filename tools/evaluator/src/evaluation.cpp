@@ -34,6 +34,7 @@ bool Evaluation::ensure_resolution(double resolution) {
 
 void Evaluation::note_coverage(int64_t utime) {
   metrics_.on_coverage(utime, tracker_->covered(), tracker_->target_count());
+  metrics_.on_object_coverage(utime, tracker_->object_covered(), tracker_->object_target_count());
 }
 
 void Evaluation::on_map_delta(const mapper::MapDelta& delta, const mapper::StateGrid& grid_after) {
@@ -108,6 +109,8 @@ RunSummary Evaluation::summary() const {
   s.distance_m = metrics_.distance_m();
   s.coverage_pct = metrics_.coverage_pct();
   s.time_r_s = metrics_.time_r_s();
+  s.object_coverage_pct = metrics_.object_coverage_pct();
+  s.time_o_s = metrics_.time_o_s();
   s.collisions = metrics_.collisions();
   s.wall_s = wall_s_;
   s.termination = to_string(metrics_.termination());
@@ -117,9 +120,11 @@ RunSummary Evaluation::summary() const {
   s.realtime_factor = wall_s_ > 0 ? s.sim_s / wall_s_ : 0.0;
   if (options_.time_limit_s > 0) s.time_limit_s = options_.time_limit_s;
   s.coverage_threshold_pct = 100.0 * options_.metrics.coverage_threshold;
+  s.object_threshold_pct = 100.0 * options_.metrics.object_threshold;
   s.resolution_m = tracker_->resolution();
   s.target_voxels = tracker_->target_count();
   s.covered_voxels = tracker_->covered();
+  s.object_voxels = tracker_->object_target_count();
   s.map_seq = map_seq_;
   s.coverage = metrics_.samples();
   s.trajectory = metrics_.trajectory();

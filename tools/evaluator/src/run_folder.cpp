@@ -105,6 +105,8 @@ std::string metrics_json(const RunSummary& s) {
   field("distance_m", number(s.distance_m));
   field("coverage_pct", number(s.coverage_pct));
   field("time_r_s", json_optional(s.time_r_s));
+  field("object_coverage_pct", number(s.object_coverage_pct));
+  field("time_o_s", json_optional(s.time_o_s));
   field("collisions", std::to_string(s.collisions));
   field("wall_s", number(s.wall_s));
   field("termination", json_string(s.termination));
@@ -114,9 +116,11 @@ std::string metrics_json(const RunSummary& s) {
   field("realtime_factor", number(s.realtime_factor, 4));
   field("time_limit_s", json_optional(s.time_limit_s));
   field("coverage_threshold_pct", number(s.coverage_threshold_pct));
+  field("object_threshold_pct", number(s.object_threshold_pct));
   field("resolution_m", number(s.resolution_m));
   field("target_voxels", std::to_string(s.target_voxels));
   field("covered_voxels", std::to_string(s.covered_voxels));
+  field("object_voxels", std::to_string(s.object_voxels));
   field("map_seq", std::to_string(s.map_seq));
   field("coverage_samples", std::to_string(s.coverage.size()));
   field("source", json_string(s.info.source), true);
@@ -126,7 +130,7 @@ std::string metrics_json(const RunSummary& s) {
 
 std::string metrics_csv_header() {
   return "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,"
-         "termination,sim_s,resolution_m,target_voxels,covered_voxels,source\n";
+         "termination,sim_s,resolution_m,target_voxels,covered_voxels,source,object_coverage_pct,time_o_s\n";
 }
 
 std::string metrics_csv_row(const RunSummary& s) {
@@ -136,16 +140,17 @@ std::string metrics_csv_row(const RunSummary& s) {
     << number(s.coverage_pct) << ',' << csv_optional(s.time_r_s) << ',' << s.collisions << ','
     << number(s.wall_s) << ',' << csv_field(s.termination) << ',' << number(s.sim_s) << ','
     << number(s.resolution_m) << ',' << s.target_voxels << ',' << s.covered_voxels << ','
-    << csv_field(s.info.source) << '\n';
+    << csv_field(s.info.source) << ',' << number(s.object_coverage_pct) << ',' << csv_optional(s.time_o_s)
+    << '\n';
   return o.str();
 }
 
 std::string coverage_csv(const RunSummary& s) {
   std::ostringstream o;
-  o << "t_s,coverage_pct,distance_m,covered_voxels\n";
+  o << "t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct\n";
   for (const auto& c : s.coverage) {
     o << number(c.t_s) << ',' << number(c.coverage_pct) << ',' << number(c.distance_m) << ',' << c.covered
-      << '\n';
+      << ',' << number(c.object_coverage_pct) << '\n';
   }
   return o.str();
 }
@@ -239,6 +244,10 @@ std::string format_metrics_table(const RunSummary& s) {
                       std::to_string(s.target_voxels) + " voxels at " + fmt("%g m)", s.resolution_m));
   const std::string tr = fmt("Time_r (%g %%)", s.coverage_threshold_pct);
   row(tr.c_str(), s.time_r_s ? fmt("%.2f s", *s.time_r_s) : std::string("N/A (never reached)"));
+  const std::string to = fmt("Time_o (%g %%)", s.object_threshold_pct);
+  row("Objects", fmt("%.2f %%", s.object_coverage_pct) + "  (of " + std::to_string(s.object_voxels) +
+                     " surface voxels of furniture)");
+  row(to.c_str(), s.time_o_s ? fmt("%.2f s", *s.time_o_s) : std::string("N/A (never reached)"));
   row("collisions", std::to_string(s.collisions));
   row("wall", fmt("%.1f s", s.wall_s) +
                   (s.realtime_factor > 0 ? fmt("  (%.1fx real time)", s.realtime_factor) : std::string()));

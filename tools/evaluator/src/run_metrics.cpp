@@ -67,6 +67,28 @@ void RunMetrics::on_odometry(int64_t utime, const Eigen::Vector3d& position) {
   note_time(utime);
 }
 
+void RunMetrics::on_object_coverage(int64_t utime, int64_t covered, int64_t target) {
+  if (finished()) return;
+  object_covered_ = covered;
+  object_target_ = target;
+  if (!time_o_utime_ && target > 0 &&
+      static_cast<double>(covered) / static_cast<double>(target) >= options_.object_threshold) {
+    time_o_utime_ = utime;
+  }
+  note_time(utime);
+}
+
+double RunMetrics::object_coverage_pct() const {
+  return object_target_ > 0
+             ? 100.0 * static_cast<double>(object_covered_) / static_cast<double>(object_target_)
+             : 0.0;
+}
+
+std::optional<double> RunMetrics::time_o_s() const {
+  if (!time_o_utime_) return std::nullopt;
+  return seconds(*time_o_utime_);
+}
+
 void RunMetrics::on_coverage(int64_t utime, int64_t covered, int64_t target) {
   if (finished()) return;
   covered_ = covered;
@@ -107,6 +129,7 @@ void RunMetrics::sample(int64_t utime) {
   s.coverage_pct = coverage_pct();
   s.distance_m = distance_m_;
   s.covered = covered_;
+  s.object_coverage_pct = object_coverage_pct();
   if (!samples_.empty() && samples_.back().t_s >= s.t_s) {
     s.t_s = samples_.back().t_s;
     samples_.back() = s;

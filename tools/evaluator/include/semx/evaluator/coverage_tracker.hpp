@@ -9,6 +9,10 @@
 // applying it only touches those voxels; a MAP_SNAPSHOT (which may change anything) is handled
 // by a recount from the map (reset). count_covered() is the same number computed from scratch,
 // for tests and checks: after any sequence of deltas and resets both agree.
+//
+// Object coverage, the same count over the objects' surfaces: the occupied target voxels whose
+// cube overlaps an object's box (GroundTruth::objects(), the box around its solids), i.e. the
+// furniture a semantic planner is meant to look at, without walls, floor and ceiling.
 #pragma once
 
 #include <cstdint>
@@ -35,6 +39,10 @@ class CoverageTracker {
   int64_t covered() const { return covered_; }
   // covered() / target_count() in [0, 1]; 0 for an empty target set.
   double coverage() const;
+  // The same over the objects' surface voxels.
+  int64_t object_target_count() const { return object_target_; }
+  int64_t object_covered() const { return object_covered_; }
+  double object_coverage() const;
 
   // Records the new state of one voxel (voxels outside T change nothing).
   void set(const mapper::VoxelKey& key, mapper::VoxelState state);
@@ -54,8 +62,10 @@ class CoverageTracker {
 
  private:
   std::shared_ptr<const simulator::GroundTruth> gt_;
-  std::vector<uint8_t> known_;  // per ground-truth cell (GroundTruth::index), target cells only
+  std::vector<uint8_t> known_;   // per ground-truth cell (GroundTruth::index), target cells only
+  std::vector<uint8_t> object_;  // per cell: an object's surface voxel in T
   int64_t covered_ = 0;
+  int64_t object_target_ = 0, object_covered_ = 0;
 };
 
 }  // namespace semx::evaluator

@@ -29,6 +29,9 @@ struct RunSummary {
   double distance_m = 0.0;
   double coverage_pct = 0.0;
   std::optional<double> time_r_s;  // null when the threshold was never reached
+  // The same over the objects' surfaces (coverage_tracker.hpp): what semantic-dep is for.
+  double object_coverage_pct = 0.0;
+  std::optional<double> time_o_s;
   int64_t collisions = 0;
   double wall_s = 0.0;  // wall-clock s from the first SIM_CLOCK, ODOMETRY or MAP_UPDATE to the end
   // Context.
@@ -39,9 +42,11 @@ struct RunSummary {
   double realtime_factor = 0.0;        // sim_s / wall_s (0 when wall_s is 0)
   std::optional<double> time_limit_s;  // null when none
   double coverage_threshold_pct = 85.0;
+  double object_threshold_pct = 75.0;
   double resolution_m = 0.0;
   int64_t target_voxels = 0;
   int64_t covered_voxels = 0;
+  int64_t object_voxels = 0;  // the objects' surface voxels in the target set
   int64_t map_seq = 0;  // last map sequence number applied
   std::vector<CoverageSample> coverage;
   std::vector<Eigen::Vector3d> trajectory;

@@ -1,0 +1,100 @@
+// The bench report: run folders read back, mean ± std over seeds, runs that never reached a
+// threshold, the margins of semantic-dep over each baseline, and files that name their errors.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "evaluator_test_util.hpp"
+#include "semx/evaluator/bench_report.hpp"
+
+namespace semx::evaluator {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string json_or_null(std::optional<double> v) { return v ? std::to_string(*v) : "null"; }
+
+// One run folder as the evaluator writes it (the fields the report reads).
+void write_run(const std::string& root, const std::string& world, const std::string& planner, int seed,
+               double time_f, std::optional<double> time_r, std::optional<double> time_o,
+               bool with_objects = true) {
+  const fs::path dir = fs::path(root) / (world + "-" + planner + "-s45-seed" + std::to_string(seed));
+  fs::create_directories(dir);
+  std::ofstream m(dir / "metrics.json");
+  m << "{\n  \"world\": \"" << world << "\",\n  \"planner\": \"" << planner << "\",\n  \"seed\": " << seed
+    << ",\n  \"samples\": 45,\n  \"time_f_s\": " << time_f << ",\n  \"distance_m\": " << 2 * time_f
+    << ",\n  \"coverage_pct\": 95,\n  \"time_r_s\": " << json_or_null(time_r) << ",\n";
+  if (with_objects) m << "  \"object_coverage_pct\": 80,\n  \"time_o_s\": " << json_or_null(time_o) << ",\n";
+  m << "  \"collisions\": 0,\n  \"wall_s\": 10,\n  \"sim_s\": " << time_f
+    << ",\n  \"termination\": \"planner_done\"\n}\n";
+  std::ofstream c(dir / "coverage.csv");
+  c << "t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct\n0,0,0,0,0\n"
+    << time_f << ",95,1,10,80\n";
+}
+
+TEST(BenchReport, TablesGiveMeansOverSeedsAndTheMarginsOfSemanticDep) {
+  const std::string root = test::temp_dir("bench_report");
+  // env1: semantic-dep 10 and 20 s to 85 % (mean 15), dep 20 and 40 (mean 30): -50 %.
+  write_run(root, "env1", "semantic-dep", 1, 100, 10, 30);
+  write_run(root, "env1", "semantic-dep", 2, 100, 20, 50);
+  write_run(root, "env1", "dep", 1, 200, 20, 60);
+  write_run(root, "env1", "dep", 2, 200, 40, std::nullopt);  // objects never at 75 %
+  // nbv never reaches 85 %, and its folders come from before object coverage.
+  write_run(root, "env1", "nbv", 1, 50, std::nullopt, std::nullopt, false);
+  const auto runs = load_bench_runs(root);
+  ASSERT_EQ(runs.size(), 5u);
+  for (const auto& r : runs) EXPECT_EQ(r.object_coverage_pct.has_value(), r.planner != "nbv") << r.dir;
+
+  const std::string md = bench_markdown(runs);
+  // Planner rows: Time_r mean ± sample std; Time_o over the runs that reached it, with the count.
+  EXPECT_NE(
+      md.find("| env1 | semantic-dep | 2 | 100.00 ± 0.00 | 200.00 ± 0.00 | 95.00 ± 0.00 | 15.00 ± 7.07 | 0 | "
+              "40.00 ± 14.14 |"),
+      std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| env1 | dep | 2 | 200.00 ± 0.00 | 400.00 ± 0.00 | 95.00 ± 0.00 | 30.00 ± 14.14 | 0 | "
+                    "60.00 (1/2) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| env1 | nbv | 1 | 50.00 | 100.00 | 95.00 | N/A | 0 | N/A |"), std::string::npos) << md;
+  // Margins: Time_f -50 %, Time_r -50 %, Time_o -33.3 % (40 against 60), distance -50 %.
+  EXPECT_NE(md.find("| env1 | dep | -50.0 % | -50.0 % | -33.3 % | -50.0 % | +0.00 |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| env1 | nbv | +100.0 % | only ours reached 85 % | only ours reached 75 % |"),
+            std::string::npos)
+      << md;
+
+  const std::string csv = bench_csv(runs);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
+            "termination,dir,object_coverage_pct,time_o_s");
+  EXPECT_NE(csv.find(",80.000,30.000\n"), std::string::npos) << csv;
+}
+
+TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {
+  const std::string root = test::temp_dir("bench_report_bad");
+  write_run(root, "env1", "dep", 1, 100, 10, 20);
+  const fs::path dir = fs::path(root) / "env1-dep-s45-seed1";
+  std::ofstream(dir / "coverage.csv", std::ios::app) << "garbage\n";
+  try {
+    load_bench_runs(root);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("coverage.csv:4"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "metrics.json")
+      << "{\"world\": \"env1\", \"planner\": \"dep\", \"time_f_s\": \"soon\"}";
+  try {
+    load_bench_run(dir.string());
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("metrics.json: 'time_f_s' is not a number"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace semx::evaluator
