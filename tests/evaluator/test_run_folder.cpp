@@ -137,8 +137,8 @@ TEST(RunFolder, TableAndProgressLine) {
   EXPECT_NE(t.find("N/A"), std::string::npos) << t;
   EXPECT_NE(t.find("91.23 %"), std::string::npos) << t;
   EXPECT_NE(format_metrics_table(example(true)).find("201.75 s"), std::string::npos);
-  EXPECT_EQ(format_progress(12.0, 34.56, 8.123, "EXECUTING"),
-            "t=12.0 s  coverage=34.6%  distance=8.12 m  planner=EXECUTING");
+  EXPECT_EQ(format_progress(12.0, 34.56, 20.14, 8.123, "EXECUTING"),
+            "t=12.0 s  coverage=34.6%  objects=20.1%  distance=8.12 m  planner=EXECUTING");
 }
 
 }  // namespace

@@ -164,7 +164,8 @@ void EvaluatorNode::progress(int64_t utime) {
   if (t < next_progress_s_) return;
   next_progress_s_ = (std::floor(t / options_.progress_s) + 1) * options_.progress_s;
   const auto& m = evaluation_.metrics();
-  const std::string line = format_progress(t, m.coverage_pct(), m.distance_m(), to_string(m.planner_state()));
+  const std::string line =
+      format_progress(t, m.coverage_pct(), m.object_coverage_pct(), m.distance_m(), to_string(m.planner_state()));
   if (options_.print) {
     std::printf("semx-evaluator: %s\n", line.c_str());
     std::fflush(stdout);

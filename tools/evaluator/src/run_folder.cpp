@@ -254,11 +254,11 @@ std::string format_metrics_table(const RunSummary& s) {
   return o.str();
 }
 
-std::string format_progress(double t_s, double coverage_pct, double distance_m,
+std::string format_progress(double t_s, double coverage_pct, double object_coverage_pct, double distance_m,
                             const std::string& planner_state) {
   char b[256];
-  std::snprintf(b, sizeof b, "t=%.1f s  coverage=%.1f%%  distance=%.2f m  planner=%s", t_s, coverage_pct,
-                distance_m, planner_state.c_str());
+  std::snprintf(b, sizeof b, "t=%.1f s  coverage=%.1f%%  objects=%.1f%%  distance=%.2f m  planner=%s", t_s,
+                coverage_pct, object_coverage_pct, distance_m, planner_state.c_str());
   return b;
 }
 

@@ -42,8 +42,8 @@ std::vector<std::string> write_run_metrics(const std::string& dir, const RunSumm
 
 // The final metrics table people read at the end of a run.
 std::string format_metrics_table(const RunSummary& s);
-// One progress line: "t=12.0 s  coverage=34.5%  distance=8.12 m  planner=EXECUTING".
-std::string format_progress(double t_s, double coverage_pct, double distance_m,
+// One progress line: "t=12.0 s  coverage=34.5%  objects=20.1%  distance=8.12 m  planner=EXECUTING".
+std::string format_progress(double t_s, double coverage_pct, double object_coverage_pct, double distance_m,
                             const std::string& planner_state);
 
 // Writes `text` to `path` atomically (path.tmp, then rename); throws RunFolderError.
