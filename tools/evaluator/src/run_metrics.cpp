@@ -48,6 +48,16 @@ const char* to_string(Termination t) {
 
 namespace {
 double seconds(int64_t utime) { return static_cast<double>(utime) * 1e-6; }
+
+double percent(int64_t covered, int64_t target) {
+  return target > 0 ? 100.0 * static_cast<double>(covered) / static_cast<double>(target) : 0.0;
+}
+
+// The first update at or above `threshold` (a fraction) fixes `at`; later ones do not move it.
+void note_threshold(int64_t utime, int64_t covered, int64_t target, double threshold,
+                    std::optional<int64_t>& at) {
+  if (!at && target > 0 && static_cast<double>(covered) / static_cast<double>(target) >= threshold) at = utime;
+}
 }  // namespace
 
 RunMetrics::RunMetrics(MetricsOptions options) : options_(options) {}
@@ -71,18 +81,11 @@ void RunMetrics::on_object_coverage(int64_t utime, int64_t covered, int64_t targ
   if (finished()) return;
   object_covered_ = covered;
   object_target_ = target;
-  if (!time_o_utime_ && target > 0 &&
-      static_cast<double>(covered) / static_cast<double>(target) >= options_.object_threshold) {
-    time_o_utime_ = utime;
-  }
+  note_threshold(utime, covered, target, options_.object_threshold, time_o_utime_);
   note_time(utime);
 }
 
-double RunMetrics::object_coverage_pct() const {
-  return object_target_ > 0
-             ? 100.0 * static_cast<double>(object_covered_) / static_cast<double>(object_target_)
-             : 0.0;
-}
+double RunMetrics::object_coverage_pct() const { return percent(object_covered_, object_target_); }
 
 std::optional<double> RunMetrics::time_o_s() const {
   if (!time_o_utime_) return std::nullopt;
@@ -93,10 +96,7 @@ void RunMetrics::on_coverage(int64_t utime, int64_t covered, int64_t target) {
   if (finished()) return;
   covered_ = covered;
   target_ = target;
-  if (!time_r_utime_ && target > 0 &&
-      static_cast<double>(covered) / static_cast<double>(target) >= options_.coverage_threshold) {
-    time_r_utime_ = utime;
-  }
+  note_threshold(utime, covered, target, options_.coverage_threshold, time_r_utime_);
   note_time(utime);
 }
 
@@ -164,7 +164,7 @@ void RunMetrics::finish(Termination why, int64_t utime, double time_limit_s) {
 double RunMetrics::time_f_s() const { return finished() ? time_f_s_ : seconds(now_utime_); }
 
 double RunMetrics::coverage_pct() const {
-  return target_ > 0 ? 100.0 * static_cast<double>(covered_) / static_cast<double>(target_) : 0.0;
+  return percent(covered_, target_);
 }
 
 std::optional<double> RunMetrics::time_r_s() const {
