@@ -1,5 +1,6 @@
 #include "semx/runtime/lcm_datagram.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 namespace semx::runtime {
@@ -39,7 +40,23 @@ int lcm_channel_length(const uint8_t* p, std::size_t left) {
   return len > 0 ? len : -1;
 }
 
-LcmReassembler::LcmReassembler(std::size_t max_message_bytes) : max_message_bytes_(max_message_bytes) {}
+LcmReassembler::LcmReassembler(std::size_t max_message_bytes)
+    : max_message_bytes_(max_message_bytes),
+      pending_budget_(std::max<std::size_t>(2 * max_message_bytes, 64u << 20)) {}
+
+void LcmReassembler::make_room(std::size_t bytes, uint64_t keep, bool adding) {
+  while (pending_bytes_ + bytes > pending_budget_ || (adding && pending_.size() >= kMaxPendingSenders)) {
+    auto oldest = pending_.end();
+    for (auto it = pending_.begin(); it != pending_.end(); ++it) {
+      if (it->first != keep && (oldest == pending_.end() || it->second.started < oldest->second.started))
+        oldest = it;
+    }
+    if (oldest == pending_.end()) return;
+    pending_bytes_ -= oldest->second.data.size();
+    pending_.erase(oldest);
+    ++counters_.incomplete;
+  }
+}
 
 DatagramError LcmReassembler::feed(uint64_t sender, const uint8_t* data, std::size_t size,
                                    LcmMessageView* out, bool* complete) {
@@ -96,20 +113,20 @@ DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data
     if (size - at > msg_size) return DatagramError::kFragment;
     if (it != pending_.end()) {
       ++counters_.incomplete;  // the sender moved on: what is missing will not come
-    } else {
-      if (pending_.size() >= kMaxPendingSenders) {
-        pending_.erase(pending_.begin());
-        ++counters_.incomplete;
-      }
-      it = pending_.emplace(sender, Pending{}).first;
+      pending_bytes_ -= it->second.data.size();
+      it->second.data.clear();
     }
+    make_room(msg_size, sender, it == pending_.end());
+    if (it == pending_.end()) it = pending_.emplace(sender, Pending{}).first;
     Pending& p = it->second;
+    p.started = ++started_;
     p.seqno = seqno;
     p.size = msg_size;
     p.remaining = count;
     p.seen.assign(count, false);
     p.channel.assign(reinterpret_cast<const char*>(data + kLcmLongHeader), static_cast<std::size_t>(len));
     p.data.resize(msg_size);
+    pending_bytes_ += msg_size;
   } else if (it == pending_.end() || it->second.seqno != seqno) {
     // The first fragment was filtered out (a channel nobody here reads) or lost.
     ++counters_.orphans;
@@ -123,6 +140,7 @@ DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data
   if (n) std::memcpy(p.data.data() + offset, data + at, n);
   p.seen[number] = true;
   if (--p.remaining > 0) return DatagramError::kNone;
+  pending_bytes_ -= p.data.size();
   done_.swap(p.data);
   channel_.swap(p.channel);
   pending_.erase(it);

@@ -62,9 +62,13 @@ class LcmReassembler {
                      bool* complete);
 
   const ReassemblyCounters& counters() const { return counters_; }
+  // Bytes held for messages still missing fragments: at most the larger of
+  // 2 x max_message_bytes and 64 MiB, whatever the senders claim.
+  std::size_t pending_bytes() const { return pending_bytes_; }
 
  private:
   struct Pending {
+    uint64_t started = 0;  // order of first fragments, for evicting the oldest
     uint32_t seqno = 0;
     uint32_t size = 0;
     uint16_t remaining = 0;
@@ -74,12 +78,18 @@ class LcmReassembler {
   };
   // Bounds what hostile senders on many ports can hold at once.
   static constexpr std::size_t kMaxPendingSenders = 32;
+  // Abandons the oldest incomplete messages (not `keep`'s) until `bytes` more fit the budget and,
+  // when `adding` a sender, the number of senders.
+  void make_room(std::size_t bytes, uint64_t keep, bool adding);
 
   DatagramError feed_fragment(uint64_t sender, const uint8_t* data, std::size_t size, LcmMessageView* out,
                               bool* complete);
 
   std::size_t max_message_bytes_;
   std::map<uint64_t, Pending> pending_;
+  std::size_t pending_bytes_ = 0;
+  std::size_t pending_budget_;
+  uint64_t started_ = 0;
   std::string channel_;  // the last small message's channel, for the view
   std::vector<uint8_t> done_;
   ReassemblyCounters counters_;
