@@ -5,6 +5,8 @@
 // layout was checked (wire_validator.hpp), the generated decoder succeeded inside try/catch and
 // the optional `accept` predicate agreed; anything else is counted as malformed and dropped.
 // Exceptions from handlers are caught and counted: nothing a sender does can escape handle().
+// One thread uses a node, publishing included (a worker hands its bytes to that thread, as the
+// mapper's does): the udpm transport keeps no locks.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
