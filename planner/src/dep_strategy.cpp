@@ -388,9 +388,10 @@ void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
 
 DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, int64_t id, bool sweep) const {
   const RoadmapNode& n = graph_.node(id);
-  const double reward = reward_at(ctx, n.position);
+  const double reward = reward_at(ctx, n.position, n.gain.yaw);
   const double d = search_.distance[static_cast<size_t>(id)];
-  View v{n.gain.yaw, n.gain.gain, score(n.gain.gain, reward, d, yaw_distance(ctx.pose.yaw, n.gain.yaw))};
+  View v{n.gain.yaw, n.gain.gain, reward,
+         score(n.gain.gain, reward, d, yaw_distance(ctx.pose.yaw, n.gain.yaw))};
   if (!sweep) return v;
   // The camera sees while it turns (the controller turns on the way, travel_cost.hpp): a turn is
   // worth what it sweeps, and the yaw that sweeps the most per second of flight is the node's.
@@ -410,7 +411,7 @@ DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, i
     const bool tie = s > v.score - 1e-9 * std::max(1.0, v.score);
     if (s > v.score + 1e-9 * std::max(1.0, v.score) ||
         (tie && (window > best_window + 1e-9 || (window > best_window - 1e-9 && turn < best_turn - 1e-9)))) {
-      v = {yaw, g, s};
+      v = {yaw, g, reward, s};
       best_window = window;
       best_turn = turn;
     }
@@ -418,11 +419,13 @@ DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, i
   return v;
 }
 
-double DepStrategy::reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const {
+double DepStrategy::reward_at(const PlanContext& ctx, const Eigen::Vector3d& p, double yaw) const {
   if (!semantic_ || !ctx.regions) return 0.0;
+  const ViewCone cone{yaw, 0.5 * config_.gain.horizontal_fov()};
+  const ViewCone* view = config_.reward.in_view ? &cone : nullptr;
   if (cycle_regions_.size() == ctx.regions->size())
-    return semantic_reward(p, cycle_regions_, &region_factor_);
-  return semantic_reward(p, *ctx.regions, &region_factor_);
+    return semantic_reward(p, cycle_regions_, &region_factor_, view);
+  return semantic_reward(p, *ctx.regions, &region_factor_, view);
 }
 
 void DepStrategy::update_region_factors(PlanContext& ctx) {
@@ -492,6 +495,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     const size_t i = static_cast<size_t>(id);
     yaw_[i] = v.yaw;
     view_gain_[i] = v.gain;
+    reward_[i] = v.reward;
     score_[i] = v.score;
     cost_[i] = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
   };
@@ -505,7 +509,6 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ++reachable;
     if (!n.gain.valid) evaluate_gain(ctx, n.id);
     const RoadmapNode& m = graph_.node(n.id);
-    reward_[static_cast<size_t>(n.id)] = reward_at(ctx, m.position);
     rate(n.id);
     if (m.blacklisted_until >= ctx.cycle || m.passage) continue;
     if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id, yaw_[static_cast<size_t>(n.id)])) continue;
@@ -634,7 +637,7 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   RoadmapNode& n = graph_.node(goal.node);
   if (n.gain_stale || !n.gain.valid) evaluate_gain(ctx, goal.node);
   if (n.gain.gain < config_.gain.min_gain) return std::nullopt;
-  const double reward = reward_at(ctx, n.position);
+  const double reward = reward_at(ctx, n.position, goal.yaw);
   // The goal keeps the yaw it was chosen with (its best yaw may have moved since); with the sweep
   // it is worth what the rest of the turn to that yaw sweeps.
   const double g = config_.gain.sweep ? gains_.sweep_gain(n.gain, ctx.pose.yaw, gains_.window_of(goal.yaw))

@@ -113,6 +113,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   auto rw = m.child("reward");
   rw.get("unexplored_weight", c.reward.unexplored_weight, 0.0, 1e3);
   rw.get("passage_weight", c.reward.passage_weight, 0.0, 1e3);
+  rw.get("in_view", c.reward.in_view);
 
   auto l = m.child("loop");
   l.get("goal_tolerance", c.loop.goal_tolerance, 0.0, 100.0);

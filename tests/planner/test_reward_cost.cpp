@@ -29,6 +29,19 @@ TEST(SemanticReward, BoundaryCases) {
   EXPECT_NEAR(region_reward({1 + 0.6, 2 + 0.8, 1}, s), 30.0 * (1 - 1.0 / 2.0), 1e-12);  // d = 1 diagonally
 }
 
+TEST(SemanticReward, InViewRewardsOnlyWhatTheNodesYawLooksAt) {
+  const SemanticRegion s = region({1, 2, 1}, 30.0, 2.0);
+  const Eigen::Vector3d node(2, 2, 1);  // 1 m east of the object: it lies at azimuth 180°
+  const ViewCone west{kPi, 0.25 * kPi}, north{0.5 * kPi, 0.25 * kPi}, edge{0.75 * kPi + 1e-9, 0.25 * kPi};
+  EXPECT_DOUBLE_EQ(region_reward(node, s, &west), 15.0);
+  EXPECT_DOUBLE_EQ(region_reward(node, s, &north), 0.0);  // looking away
+  EXPECT_DOUBLE_EQ(region_reward(node, s, &edge), 15.0);  // at the edge of the 90° window
+  EXPECT_DOUBLE_EQ(region_reward(node, s), 15.0);         // the paper's reward: no view
+  const std::vector<SemanticRegion> both = {s, region({3, 2, 1}, 10.0, 2.0)};  // one each side
+  EXPECT_DOUBLE_EQ(semantic_reward(node, both, nullptr, &west), 15.0);
+  EXPECT_DOUBLE_EQ(semantic_reward(node, both), 20.0);
+}
+
 TEST(SemanticReward, SumsOverRegionsAndSkipsInactiveOnes) {
   const std::vector<SemanticRegion> regions{
       region({0, 0, 0}, 10.0, 1.0), region({1, 0, 0}, 20.0, 2.0),

@@ -114,11 +114,12 @@ class DepStrategy : public Strategy {
   struct View {
     double yaw = 0.0;
     double gain = 0.0;
+    double reward = 0.0;
     double score = 0.0;
   };
   View view_of(PlanContext& ctx, const ScoreFn& score, int64_t id, bool sweep) const;
   // R_sem at p with this cycle's region factors (0 for plain DEP).
-  double reward_at(const PlanContext& ctx, const Eigen::Vector3d& p) const;
+  double reward_at(const PlanContext& ctx, const Eigen::Vector3d& p, double yaw) const;
   // Each region's 1 + κ U_i (config reward.unexplored_weight), or a door's a_i + κ_p U_i
   // (reward.passage_weight), for this cycle's regions.
   void update_region_factors(PlanContext& ctx);

@@ -139,6 +139,10 @@ struct RewardConfig {
   // behind), not whether the leaf itself was seen, so the term outlives the leaf's observation
   // and fades as the room is mapped. 0: the paper's reward.
   double passage_weight = 0.0;
+  // An ablation: a region rewards a node only when its centroid lies in the camera's horizontal
+  // field of view at the node's yaw (docs/planner.md, "Semantic reward"). false: the paper's
+  // Eq. 6, every region within r_i whichever way the node looks.
+  bool in_view = false;
 };
 
 // The main loop: when to replan, when to give up.

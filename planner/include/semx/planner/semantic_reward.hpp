@@ -21,10 +21,17 @@ struct SemanticRegion {
   bool active = true;                                  // false once fully observed
 };
 
+// The camera's horizontal view from a node: regions outside it reward nothing when one is given
+// (RewardConfig::in_view, an ablation; the paper's reward counts every region within r_i).
+struct ViewCone {
+  double yaw = 0.0;       // rad
+  double half_fov = 0.0;  // rad
+};
+
 // R_i(n) of one region.
-double region_reward(const Eigen::Vector3d& p, const SemanticRegion& region);
+double region_reward(const Eigen::Vector3d& p, const SemanticRegion& region, const ViewCone* view = nullptr);
 // R_sem(n); `factors`, when given and one per region, multiply each region's R_i.
 double semantic_reward(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
-                       const std::vector<double>* factors = nullptr);
+                       const std::vector<double>* factors = nullptr, const ViewCone* view = nullptr);
 
 }  // namespace semx::planner
