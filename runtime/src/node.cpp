@@ -154,13 +154,11 @@ void Node::skip_unless(const std::string& channel, std::function<bool(int64_t ut
 }
 
 void Node::subscribe_raw(const std::string& regex, RawHandler handler) {
-  std::regex pattern;
   try {
-    pattern = std::regex(regex, std::regex::extended);
-  } catch (const std::regex_error& e) {
-    throw NodeError("channel pattern '" + regex + "' is not a regular expression: " + e.what());
+    raw_handlers_.push_back({ChannelPattern(regex), std::move(handler)});
+  } catch (const std::invalid_argument& e) {
+    throw NodeError(e.what());
   }
-  raw_handlers_.push_back({std::move(pattern), std::move(handler)});
   if (udpm_) {
     update_receiver();  // the kernel filter cannot match patterns: everything passes
   } else if (raw_handlers_.size() == 1) {
@@ -180,7 +178,7 @@ void Node::on_lcm_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string&
 void Node::on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size) {
   // Raw subscribers see the bytes as they came; they count nothing as malformed themselves.
   for (auto& raw : raw_handlers_) {
-    if (!std::regex_match(channel, raw.pattern)) continue;
+    if (!raw.pattern.matches(channel)) continue;
     try {
       raw.handler(channel, data, size);
     } catch (const std::exception& e) {

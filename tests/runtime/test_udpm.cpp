@@ -29,6 +29,15 @@ namespace {
 // Ports of their own, apart from the process tests' 20000-39999.
 int port(int offset) { return 40000 + (static_cast<int>(getpid()) % 2000) * 10 + offset; }
 
+// A node on the port of `offset`, named `name`, logging nothing.
+NodeOptions node_options(const std::string& name, int offset) {
+  NodeOptions o;
+  o.name = name;
+  o.lcm_url = udpm_url_for_port(port(offset));
+  o.quiet = true;
+  return o;
+}
+
 UdpmEndpoint endpoint(int offset) {
   auto e = parse_udpm_url(udpm_url_for_port(port(offset)));
   EXPECT_TRUE(e.has_value());
@@ -168,10 +177,7 @@ TEST(Udpm, TheKernelFilterPassesOnlyTheChannelsAsked) {
 TEST(Udpm, ANodeGetsMessagesOneAtATimeInTheOrderTheyWereSent) {
   // Lockstep rests on this: what a sender published before its ack is handled before the ack,
   // across channels and sizes (a large message's fragments interleave with nothing).
-  const std::string url = udpm_url_for_port(port(4));
-  NodeOptions o;
-  o.name = "reader";
-  o.lcm_url = url;
+  NodeOptions o = node_options("reader", 4);
   o.follow_clock = false;
   Node reader(o);
   ASSERT_TRUE(reader.own_receiver());
@@ -181,9 +187,8 @@ TEST(Udpm, ANodeGetsMessagesOneAtATimeInTheOrderTheyWereSent) {
       order.push_back(c + ":" + std::to_string(n ? d[0] : 0) + ":" + std::to_string(n));
     });
   }
-  NodeOptions w = o;
-  w.name = "writer";
-  Node writer(w);
+  o.name = "writer";
+  Node writer(o);
   std::vector<std::string> sent;
   std::vector<uint8_t> big(200000, 0);
   for (int i = 0; i < 60; ++i) {
@@ -204,12 +209,7 @@ TEST(Udpm, ANodeGetsMessagesOneAtATimeInTheOrderTheyWereSent) {
 }
 
 TEST(Udpm, ANodeCountsGarbageDatagramsAndKeepsWorking) {
-  const std::string url = udpm_url_for_port(port(3));
-  NodeOptions o;
-  o.name = "target";
-  o.lcm_url = url;
-  o.quiet = true;
-  Node node(o);
+  Node node(node_options("target", 3));
   ASSERT_TRUE(node.own_receiver());
   int odometry = 0;
   node.subscribe<semx::odometry_t>(semx::channels::ODOMETRY, [&](const semx::odometry_t&) { ++odometry; });
@@ -239,10 +239,7 @@ TEST(Udpm, ANodeCountsGarbageDatagramsAndKeepsWorking) {
                 static_cast<ssize_t>(g.size()));
   ::close(fd);
 
-  NodeOptions po;
-  po.name = "sender";
-  po.lcm_url = url;
-  Node sender(po);
+  Node sender(node_options("sender", 3));
   semx::odometry_t m{};
   m.orientation[0] = 1;
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(sender.publish(semx::channels::ODOMETRY, m));

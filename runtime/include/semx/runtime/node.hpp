@@ -19,11 +19,11 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <regex>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "semx/runtime/channel_pattern.hpp"
 #include "semx/runtime/lcm_schema.hpp"
 #include "semx/runtime/sim_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
@@ -193,7 +193,7 @@ class Node {
   std::unique_ptr<lcm::LCM> lcm_;  // other providers only
   std::map<std::string, std::vector<std::unique_ptr<Subscription>>> subs_;
   struct RawSubscription {
-    std::regex pattern;  // a full match, as liblcm anchors its channel regexes
+    ChannelPattern pattern;
     RawHandler handler;
   };
   std::vector<RawSubscription> raw_handlers_;

@@ -2,16 +2,17 @@
 // extended regular expression that must match the whole name), optionally inverted.
 #pragma once
 
-#include <regex>
 #include <string>
 #include <vector>
+
+#include "semx/runtime/channel_pattern.hpp"
 
 namespace semx::tools {
 
 class ChannelSelection {
  public:
   // Throws std::invalid_argument naming the pattern when it is not a regular expression.
-  ChannelSelection(const std::string& pattern, bool invert);
+  ChannelSelection(const std::string& pattern, bool invert) : pattern_(pattern), invert_(invert) {}
 
   bool wants(const std::string& channel) const;
   // The channels of semx (channels.hpp) this selection refuses, for the kernel to drop before
@@ -19,7 +20,7 @@ class ChannelSelection {
   std::vector<std::string> refused_known() const;
 
  private:
-  std::regex pattern_;
+  runtime::ChannelPattern pattern_;
   bool invert_;
 };
 
