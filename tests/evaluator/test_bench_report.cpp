@@ -74,6 +74,25 @@ TEST(BenchReport, TablesGiveMeansOverSeedsAndTheMarginsOfSemanticDep) {
   EXPECT_NE(csv.find(",80.000,30.000\n"), std::string::npos) << csv;
 }
 
+// Seed by seed: only seeds both reached 85 % in count; ties within 0.05 s are the same flight;
+// the interval is the paired mean difference ± t(0.975, n-1) · sd / √n.
+TEST(BenchReport, SeedBySeedComparisonCountsWinsAndGivesTheIntervalOfTheDifference) {
+  const std::string root = test::temp_dir("bench_report_paired");
+  const double ours[] = {10, 20, 30, 40, 50}, dep[] = {12, 20.04, 35, 41, -1}, aep[] = {5, 6, 7, 8, 9};
+  for (int seed = 1; seed <= 5; ++seed) {
+    write_run(root, "env2", "semantic-dep", seed, 100, ours[seed - 1], 1);
+    // dep's seed 5 never reached 85 %: left out of the pairs.
+    write_run(root, "env2", "dep", seed, 100,
+              dep[seed - 1] < 0 ? std::nullopt : std::optional<double>(dep[seed - 1]), 1);
+    if (seed <= 3) write_run(root, "env2", "aep", seed, 100, aep[seed - 1], 1);
+  }
+  const std::string md = bench_markdown(load_bench_runs(root));
+  // Differences -2, -0.04, -5, -1: 3 sooner, 1 the same; mean -2.01, sd 2.148, t(3) 3.182.
+  EXPECT_NE(md.find("| env2 | dep | 4 | 3 / 1 / 0 | -2.01 | [-5.43, 1.41] |"), std::string::npos) << md;
+  // Later in all three seeds aep ran: +5, +14, +23; mean 14, sd 9, t(2) 4.303: [-8.4, 36.4].
+  EXPECT_NE(md.find("| env2 | aep | 3 | 0 / 0 / 3 | +14.00 | [-8.36, 36.36] |"), std::string::npos) << md;
+}
+
 TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {
   const std::string root = test::temp_dir("bench_report_bad");
   write_run(root, "env1", "dep", 1, 100, 10, 20);

@@ -115,6 +115,38 @@ double number_of(const YAML::Node& n, const char* key, const std::string& file) 
   }
 }
 
+// Two-sided 95 % quantile of Student's t with `df` degrees of freedom (the normal's past 30).
+double t975(int df) {
+  static const double table[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+                                 2.201,  2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
+                                 2.080,  2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
+  return df < 1 ? 0.0 : df <= 30 ? table[df - 1] : 1.960;
+}
+
+// Time_r seed by seed: the seeds both planners ran and both reached 85 % in, and of those how
+// many ours reached sooner, at the same time (within 0.05 s: the same flight to 85 %) or later,
+// with the paired mean difference and its 95 % interval (Student's t over the seeds). A margin
+// of the means says which mean is lower; this says whether the seeds could tell.
+std::string paired_row(const Group& ours, const Group& theirs, std::optional<double> BenchRun::*field) {
+  std::vector<double> d;
+  int sooner = 0, same = 0, later = 0;
+  for (const BenchRun* a : ours.runs)
+    for (const BenchRun* b : theirs.runs) {
+      if (a->seed != b->seed || !(a->*field) || !(b->*field)) continue;
+      const double x = *(a->*field) - *(b->*field);
+      d.push_back(x);
+      (x < -0.05 ? sooner : x > 0.05 ? later : same)++;
+    }
+  if (d.empty()) return "0 | – | – | – |";
+  const Stat s = stat_of(d);
+  std::string interval = "–";
+  if (s.n > 1) {
+    const double h = t975(s.n - 1) * s.std / std::sqrt(static_cast<double>(s.n));
+    interval = "[" + fmt(s.mean - h, 2) + ", " + fmt(s.mean + h, 2) + "]";
+  }
+  return std::to_string(s.n) + " | " + std::to_string(sooner) + " / " + std::to_string(same) + " / " +
+         std::to_string(later) + " | " + (s.mean >= 0 ? "+" : "") + fmt(s.mean, 2) + " | " + interval + " |";
+}
 }  // namespace
 
 Stat stat_of(const std::vector<double>& values) {
@@ -265,6 +297,26 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
          << time_r << " | " << time_o << " | "
          << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
          << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
+    }
+  }
+
+  md << "\n### " << o.sweep_planner << " against each baseline, Time_r seed by seed\n\n"
+     << "Over the seeds where both reached 85 %: how many " << o.sweep_planner
+     << " reached sooner / at the same time (±0.05 s) / later, the mean of its time minus the baseline's, "
+        "and that mean's 95 % interval (Student's t over the seeds; an interval across 0: these seeds "
+        "do not tell the two apart).\n\n"
+     << "| Env. | vs | seeds | sooner / same / later | mean difference (s) | 95 % interval (s) |\n"
+     << "|---|---|---|---|---|---|\n";
+  for (const auto& w : worlds) {
+    const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
+    if (ours.runs.empty()) continue;
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    for (const auto& p : planners_of(here)) {
+      if (p == o.sweep_planner) continue;
+      md << "| " << w << " | " << p << " | "
+         << paired_row(ours, select(runs, w, p, o.comparison_samples), &BenchRun::time_r_s) << "\n";
     }
   }
   double wall = 0, sim = 0;
