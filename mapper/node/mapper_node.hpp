@@ -23,7 +23,7 @@
 // publishes every frame received so far, so those always describe the map of the last published
 // MAP_UPDATE. MAP_REQUESTs received while following a LOCKSTEP clock are
 // answered in the next tick handler (so every run answers at the same tick); otherwise, or when
-// no tick comes within `request_grace_s` of wall time (the simulator ended), at once.
+// no message at all comes for `request_grace_s` of wall time (the simulator ended), at once.
 #pragma once
 
 #include <semx/depth_image_t.hpp>
@@ -54,8 +54,11 @@ struct MapperNodeOptions {
   // A checkpoint that exists but cannot be loaded: start with an empty map instead of failing
   // (the bad file is renamed to <path>.bad so the next checkpoint does not destroy the evidence).
   bool ignore_bad_checkpoint = false;
-  // Wall seconds a MAP_REQUEST may wait for the next lockstep tick before it is answered anyway.
-  double request_grace_s = 0.5;
+  // Wall seconds without any message after which a LOCKSTEP clock counts as stopped (the
+  // simulator ended): a pending MAP_REQUEST is answered and frames in flight are published
+  // without their tick. A clock that waits for a slow node resends its tick every 0.5 s, so a
+  // running one is never this silent.
+  double request_grace_s = 1.0;
   bool quiet = false;  // no log lines for malformed or rejected frames
 };
 
@@ -170,6 +173,9 @@ class MapperNode {
   bool checkpoint_failing_ = false;
   bool request_pending_ = false;
   std::chrono::steady_clock::time_point request_since_;
+  // When the node last handled a message (wall): the clock's silence is measured from it.
+  std::chrono::steady_clock::time_point last_heard_ = std::chrono::steady_clock::now();
+  bool clock_silent() const;
 
   // Pipelined LOCKSTEP frames (streaming.lockstep_delay > 0). in_flight_ is the node thread's
   // list, in arrival order; queue_ what the worker has yet to start. A Job's fields are written

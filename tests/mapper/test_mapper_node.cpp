@@ -13,12 +13,14 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mapper_node.hpp"
 #include "mapper_test_util.hpp"
 #include "messages.hpp"
 #include "semx/runtime/channels.hpp"
+#include "semx/runtime/lcm_url.hpp"
 
 namespace semx::mapper {
 namespace {
@@ -507,6 +509,65 @@ TEST(MapperNode, LockstepDelayPublishesAFramesOutputsAtAFixedLaterTick) {
   EXPECT_EQ(stats[1].seq, 4);
   EXPECT_GT(wire.index_of(ch::MAP_STATS, 1), wire.index_of(ch::MAP_UPDATE, 3));
   expect_same(mn.mapper().map().grid(), reference.map().grid());
+}
+
+// The running process's loop over real sockets: a frame in flight waits for its tick however
+// many spins end without a message (every fragment of a depth frame that arrives alone ends one;
+// here a 2 ms status period does), and goes out without it only after a second of silence, when
+// the clock has stopped. Counting ten empty spins instead published frames early on a loaded
+// machine, and runs of one seed flew differently.
+TEST(MapperNode, AFrameInFlightWaitsForItsTickUntilTheClockIsSilent) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(2, cam, 2);
+  MapperConfig cfg = small_config();
+  cfg.streaming.stats_period = 0;
+  cfg.streaming.lockstep_delay = 0.04;
+  const std::string url = runtime::udpm_url_for_port(30000 + (static_cast<int>(getpid()) % 2000) * 10 + 3);
+  runtime::NodeOptions mo = memq_node("mapper", /*lockstep=*/true);
+  mo.lcm_url = url;
+  mo.status_period_s = 0.002;
+  runtime::Node mapper_node(mo);
+  MapperNode mn(mapper_node, cfg);
+  runtime::NodeOptions to = memq_node("driver");
+  to.lcm_url = url;
+  runtime::Node driver(to);
+  std::vector<std::pair<int64_t, int64_t>> updates;  // (frame utime, last tick sent when it came)
+  int64_t last_tick = -1;
+  driver.subscribe<semx::map_update_t>(
+      ch::MAP_UPDATE, [&](const semx::map_update_t& m) { updates.emplace_back(m.utime, last_tick); });
+  std::thread loop([&] { mn.run(); });
+  auto listen = [&](double seconds, size_t until_updates = SIZE_MAX) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && updates.size() < until_updates) driver.spin_once(5);
+  };
+  auto tick = [&](int64_t t) {
+    last_tick = t;
+    driver.publish(ch::SIM_CLOCK, clock_at(t, t * 10000, true));
+    listen(0.02);
+  };
+  listen(0.2);  // the mapper's socket is up
+  tick(0);
+  driver.publish(ch::ODOMETRY, odometry_at(Eigen::Vector3d(3, 2.5, 1.3), 10000));
+  driver.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[0], 10000));
+  tick(1);
+  listen(0.5);  // a slow tick: hundreds of empty spins, half a second
+  EXPECT_TRUE(updates.empty()) << "published before its tick";
+  for (int64_t t = 2; t <= 6; ++t) tick(t);
+  listen(0.8, 1);  // a loaded machine may take a while; nothing is in flight once it is out
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_EQ(updates[0].first, 10000);
+  // Not before tick 5 (0.01 s + lockstep_delay 0.04 s; which tick exactly is the memq test's).
+  EXPECT_GE(updates[0].second, 5);
+  // The clock stops with a frame in flight: it goes out after a second of silence.
+  driver.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[1], 70000));
+  tick(7);
+  listen(0.5);
+  EXPECT_EQ(updates.size(), 1u);
+  listen(2.0, 2);
+  ASSERT_EQ(updates.size(), 2u);
+  EXPECT_EQ(updates[1].first, 70000);
+  mapper_node.stop();
+  loop.join();
 }
 
 // In LOCKSTEP the node's outputs for tick k are on the wire before its SIM_ACK(k), and a

@@ -9,6 +9,8 @@
 // mapper's does): the udpm transport keeps no locks.
 #pragma once
 
+#include <atomic>
+
 #include <lcm/lcm-cpp.hpp>
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
@@ -160,6 +162,7 @@ class Node {
   int drain();
   // Spins until shutdown_requested() or stop(); returns a process exit code.
   int run();
+  // The one call another thread may make: ends run() (and loops on stopped()) after its spin.
   void stop() { stop_ = true; }
   bool stopped() const { return stop_ || shutdown_requested(); }
 
@@ -221,7 +224,7 @@ class Node {
   std::map<std::string, ChannelCounters> outgoing_;
   std::chrono::steady_clock::time_point next_status_;
   std::size_t announcements_ = 0;  // statuses sent so far, up to the announce delays' count
-  bool stop_ = false;
+  std::atomic<bool> stop_{false};
 };
 
 // ---- templates ----
