@@ -164,6 +164,79 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
   }
 }
 
+// node_free and passage_free are their definition, brute force: no non-free voxel overlaps the
+// open box (body plus margin, or the bare body) and the ESDF keeps the clearance; on a cluttered
+// map, and around a single voxel where only the box's corners reach it. Each check is counted
+// (box, then the ESDF when the box is free): the planning-time charge is made of these counts.
+TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
+  mapper::StateGrid g(0.1);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> coord(0, 39), state(0, 9);
+  fill(g, {0, 0, 0}, {39, 39, 24}, VoxelState::kFree);
+  for (int i = 0; i < 60; ++i) {
+    const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 25};
+    g.set_state(k, state(rng) < 6 ? VoxelState::kOccupied : VoxelState::kUnknown);
+  }
+  const CollisionConfig config;
+  CollisionChecker c(config);
+  c.set_grid(&g);
+  auto box_free_in = [](const mapper::StateGrid& m, const Eigen::Vector3d& p, const Eigen::Vector3d& half) {
+    const double r = m.resolution();
+    const Eigen::Vector3i lo_key = ((p - half) / r).array().floor().cast<int>() - 1,
+                          hi_key = ((p + half) / r).array().floor().cast<int>() + 1;
+    for (int32_t z = lo_key.z(); z <= hi_key.z(); ++z)
+      for (int32_t y = lo_key.y(); y <= hi_key.y(); ++y)
+        for (int32_t x = lo_key.x(); x <= hi_key.x(); ++x) {
+          if (m.state(mapper::VoxelKey{x, y, z}) == VoxelState::kFree) continue;
+          const Eigen::Vector3d lo(x * r, y * r, z * r), hi = lo + Eigen::Vector3d::Constant(r);
+          if (((lo - (p + half)).array() < 0).all() && ((hi - (p - half)).array() > 0).all()) return false;
+        }
+    return true;
+  };
+  auto box_free = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& half) {
+    return box_free_in(g, p, half);
+  };
+  const Eigen::Vector3d body = 0.5 * config.vehicle_size + Eigen::Vector3d::Constant(config.margin);
+  const Eigen::Vector3d bare = 0.5 * config.vehicle_size;
+  std::uniform_real_distribution<double> pos(0.5, 3.5), height(0.4, 2.1);
+  int free_nodes = 0, blocked_by_box = 0;
+  for (int i = 0; i < 600; ++i) {
+    const Eigen::Vector3d p(pos(rng), pos(rng), height(rng));
+    const double v = c.esdf(p, config.clearance);
+    const bool node = box_free(p, body) && v >= config.clearance;
+    const bool passage = box_free(p, bare) && c.esdf(p, config.door_clearance) >= config.door_clearance;
+    c.reset_counters();
+    EXPECT_EQ(c.node_free(p), node) << p.transpose();
+    // Box first, then the ESDF when the box is free: 1 or 2 checks.
+    EXPECT_EQ(c.box_checks(), box_free(p, body) ? 2 : 1) << p.transpose();
+    EXPECT_EQ(c.passage_free(p), passage) << p.transpose();
+    free_nodes += node;
+    blocked_by_box += !box_free(p, body) && v >= config.clearance;
+  }
+  // Both outcomes occur, and the box decides some points the clearance alone would pass.
+  EXPECT_GT(free_nodes, 50);
+  EXPECT_LT(free_nodes, 550);
+  EXPECT_GT(blocked_by_box, 0);
+  // Where the shortcut's bound is tight: one voxel near a corner of the box, in every direction.
+  mapper::StateGrid one(0.1);
+  fill(one, {0, 0, 0}, {39, 39, 24}, VoxelState::kFree);
+  one.set_state(mapper::VoxelKey{20, 20, 12}, VoxelState::kOccupied);
+  c.set_grid(&one);
+  const Eigen::Vector3d voxel(2.05, 2.05, 1.25);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> dist(0.45, 0.75);
+  int corner_hits = 0;
+  for (int i = 0; i < 3000; ++i) {
+    Eigen::Vector3d u(normal(rng), normal(rng), normal(rng));
+    u.normalize();
+    const Eigen::Vector3d p = voxel + dist(rng) * u;
+    const bool box = box_free_in(one, p, body);
+    EXPECT_EQ(c.node_free(p), box && c.esdf(p, config.clearance) >= config.clearance) << p.transpose();
+    corner_hits += !box && c.esdf(p, config.clearance) >= body.norm();
+  }
+  EXPECT_GT(corner_hits, 0);  // the box's corners reach the voxel farther than its half diagonal
+}
+
 TEST(Collision, EdgesKeepTheClearanceAllAlong) {
   mapper::StateGrid g = known_room();
   CollisionChecker c(CollisionConfig{});
