@@ -80,17 +80,25 @@ TEST(BenchReport, SeedBySeedComparisonCountsWinsAndGivesTheIntervalOfTheDifferen
   const std::string root = test::temp_dir("bench_report_paired");
   const double ours[] = {10, 20, 30, 40, 50}, dep[] = {12, 20.04, 35, 41, -1}, aep[] = {5, 6, 7, 8, 9};
   for (int seed = 1; seed <= 5; ++seed) {
+    // Time_o: ours 1 s everywhere, the baselines 2 s (aep) and 1 s (dep).
     write_run(root, "env2", "semantic-dep", seed, 100, ours[seed - 1], 1);
     // dep's seed 5 never reached 85 %: left out of the pairs.
     write_run(root, "env2", "dep", seed, 100,
               dep[seed - 1] < 0 ? std::nullopt : std::optional<double>(dep[seed - 1]), 1);
-    if (seed <= 3) write_run(root, "env2", "aep", seed, 100, aep[seed - 1], 1);
+    if (seed <= 3) write_run(root, "env2", "aep", seed, 100, aep[seed - 1], 2);
   }
   const std::string md = bench_markdown(load_bench_runs(root));
   // Differences -2, -0.04, -5, -1: 3 sooner, 1 the same; mean -2.01, sd 2.148, t(3) 3.182.
-  EXPECT_NE(md.find("| env2 | dep | 4 | 3 / 1 / 0 | -2.01 | [-5.43, 1.41] |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | dep | Time_r | 4 | 3 / 1 / 0 | -2.01 | [-5.43, 1.41] |"), std::string::npos)
+      << md;
+  // Time_o pairs all five seeds (dep's seed 5 reached 75 % of the objects): the same each time.
+  EXPECT_NE(md.find("| env2 | dep | Time_o | 5 | 0 / 5 / 0 | +0.00 | [0.00, 0.00] |"), std::string::npos)
+      << md;
   // Later in all three seeds aep ran: +5, +14, +23; mean 14, sd 9, t(2) 4.303: [-8.4, 36.4].
-  EXPECT_NE(md.find("| env2 | aep | 3 | 0 / 0 / 3 | +14.00 | [-8.36, 36.36] |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | aep | Time_r | 3 | 0 / 0 / 3 | +14.00 | [-8.36, 36.36] |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| env2 | aep | Time_o | 3 | 3 / 0 / 0 | -1.00 | [-1.00, -1.00] |"), std::string::npos)
+      << md;
 }
 
 TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {
