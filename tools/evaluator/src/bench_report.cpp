@@ -125,8 +125,8 @@ double t975(int df) {
 
 // A time (Time_r, Time_o) seed by seed: the seeds both planners ran and both reached its
 // threshold in, and of those how many ours reached sooner, at the same time (within 0.05 s: the same flight
-// to 85 %) or later, with the paired mean difference and its 95 % interval (Student's t over the seeds). A
-// margin of the means says which mean is lower; this says whether the seeds could tell.
+// to the threshold) or later, with the paired mean difference and its 95 % interval (Student's t over the
+// seeds). A margin of the means says which mean is lower; this says whether the seeds could tell.
 std::string paired_row(const Group& ours, const Group& theirs, std::optional<double> BenchRun::*field) {
   std::vector<double> d;
   int sooner = 0, same = 0, later = 0;
@@ -225,6 +225,23 @@ std::vector<BenchRun> load_bench_runs(const std::string& root) {
   return runs;
 }
 
+// Calls f(world, ours, theirs) for every world with runs of the sweep planner at the comparison
+// density and every other planner there, in the tables' order.
+template <class F>
+void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptions& o, F&& f) {
+  for (const auto& w : worlds_of(runs)) {
+    const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
+    if (ours.runs.empty()) continue;
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    for (const auto& p : planners_of(here)) {
+      if (p == o.sweep_planner) continue;
+      f(w, p, ours, select(runs, w, p, o.comparison_samples));
+    }
+  }
+}
+
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
   std::ostringstream md;
   const auto worlds = worlds_of(runs);
@@ -271,34 +288,26 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
     const double d = 100.0 * (ours - theirs) / theirs;
     return (d >= 0 ? "+" : "") + fmt(d, 1) + " %";
   };
-  for (const auto& w : worlds) {
-    const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
-    if (ours.runs.empty()) continue;
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
-    for (const auto& p : planners_of(here)) {
-      if (p == o.sweep_planner) continue;
-      const Group theirs = select(runs, w, p, o.comparison_samples);
-      auto margin = [&](std::optional<double> BenchRun::*field, const char* threshold) {
-        int ro = 0, rt = 0;
-        const Stat so = ours.time_r(&ro, field), st = theirs.time_r(&rt, field);
-        if (ro > 0 && rt > 0) return pct(so.mean, st.mean);
-        return ro > 0   ? "only ours reached " + std::string(threshold)
-               : rt > 0 ? "only theirs reached " + std::string(threshold)
-                        : std::string("–");
-      };
-      const std::string time_r = margin(&BenchRun::time_r_s, "85 %");
-      const std::string time_o = margin(&BenchRun::time_o_s, "75 %");
-      const double dc =
-          ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
-      md << "| " << w << " | " << p << " | "
-         << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean) << " | "
-         << time_r << " | " << time_o << " | "
-         << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
-         << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
-    }
-  }
+  for_each_baseline(
+      runs, o, [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
+        auto margin = [&](std::optional<double> BenchRun::*field, const char* threshold) {
+          int ro = 0, rt = 0;
+          const Stat so = ours.time_r(&ro, field), st = theirs.time_r(&rt, field);
+          if (ro > 0 && rt > 0) return pct(so.mean, st.mean);
+          return ro > 0   ? "only ours reached " + std::string(threshold)
+                 : rt > 0 ? "only theirs reached " + std::string(threshold)
+                          : std::string("–");
+        };
+        const std::string time_r = margin(&BenchRun::time_r_s, "85 %");
+        const std::string time_o = margin(&BenchRun::time_o_s, "75 %");
+        const double dc =
+            ours.metric(&BenchRun::coverage_pct).mean - theirs.metric(&BenchRun::coverage_pct).mean;
+        md << "| " << w << " | " << p << " | "
+           << pct(ours.metric(&BenchRun::time_f_s).mean, theirs.metric(&BenchRun::time_f_s).mean) << " | "
+           << time_r << " | " << time_o << " | "
+           << pct(ours.metric(&BenchRun::distance_m).mean, theirs.metric(&BenchRun::distance_m).mean) << " | "
+           << (dc >= 0 ? "+" : "") << fmt(dc, 2) << " |\n";
+      });
 
   md << "\n### " << o.sweep_planner << " against each baseline, seed by seed\n\n"
      << "Over the seeds where both reached the threshold (Time_r: 85 % of the volume; Time_o: 75 % of "
@@ -309,20 +318,13 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
         "do not tell the two apart).\n\n"
      << "| Env. | vs | time | seeds | sooner / same / later | mean difference (s) | 95 % interval (s) |\n"
      << "|---|---|---|---|---|---|---|\n";
-  for (const auto& w : worlds) {
-    const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
-    if (ours.runs.empty()) continue;
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
-    for (const auto& p : planners_of(here)) {
-      if (p == o.sweep_planner) continue;
-      const Group theirs = select(runs, w, p, o.comparison_samples);
-      md << "| " << w << " | " << p << " | Time_r | " << paired_row(ours, theirs, &BenchRun::time_r_s) << "\n"
-         << "| " << w << " | " << p << " | Time_o | " << paired_row(ours, theirs, &BenchRun::time_o_s)
-         << "\n";
-    }
-  }
+  for_each_baseline(runs, o,
+                    [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
+                      md << "| " << w << " | " << p << " | Time_r | "
+                         << paired_row(ours, theirs, &BenchRun::time_r_s) << "\n"
+                         << "| " << w << " | " << p << " | Time_o | "
+                         << paired_row(ours, theirs, &BenchRun::time_o_s) << "\n";
+                    });
   double wall = 0, sim = 0;
   for (const auto& r : runs) {
     wall += r.wall_s;
