@@ -262,10 +262,7 @@ void MapperNode::on_request(const semx::map_request_t& /*m*/) {
     publish_snapshot();
     return;
   }
-  if (!request_pending_) {
-    request_pending_ = true;
-    request_since_ = std::chrono::steady_clock::now();
-  }
+  request_pending_ = true;
 }
 
 void MapperNode::on_tick(int64_t tick, int64_t utime) {
@@ -316,11 +313,10 @@ bool MapperNode::clock_silent() const {
 }
 
 void MapperNode::poll_wall() {
-  // Silence, not the time since the request: on a loaded machine the ticks up to the promised one
-  // can take longer than any fixed wait, and answering before them gave runs of the same seed
-  // different maps.
-  if (request_pending_ && std::chrono::steady_clock::now() - std::max(request_since_, last_heard_) >=
-                              std::chrono::duration<double>(options_.request_grace_s)) {
+  // Silence (measured from the last message, the request being one), not the time since the
+  // request: on a loaded machine the ticks up to the promised one can take longer than any fixed
+  // wait, and answering before them gave runs of the same seed different maps.
+  if (request_pending_ && clock_silent()) {
     flush_without_clock();
     publish_snapshot();
   }

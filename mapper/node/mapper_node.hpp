@@ -172,7 +172,6 @@ class MapperNode {
   int64_t checkpoint_seq_ = 0;  // map seq of the last checkpoint written or loaded (0: the empty map)
   bool checkpoint_failing_ = false;
   bool request_pending_ = false;
-  std::chrono::steady_clock::time_point request_since_;
   // When the node last handled a message (wall): the clock's silence is measured from it.
   std::chrono::steady_clock::time_point last_heard_ = std::chrono::steady_clock::now();
   bool clock_silent() const;
