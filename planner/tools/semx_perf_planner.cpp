@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
   return run_main("semx-perf-planner", [&] {
     std::string world_name = "apartment", planner_name, config_file;
     int64_t samples = 0, seed = -1, runs = 1;
-    double max_time = 900.0, semantic_weight = 0.0;
+    double max_time = 900.0, semantic_weight = 0.0, coverage_period = 1.0;
     bool fit = false, verbose = false, kernels = false, oracle = false;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
@@ -165,13 +165,20 @@ int main(int argc, char** argv) {
         .option("semantic-weight", "W",
                 "emulated semantics: every object of the world is a region of this weight (default 0: none)",
                 &semantic_weight)
+        .option("coverage-period", "S",
+                "simulated seconds between coverage samples, the resolution of "
+                "run_time_to_85 (default 1)",
+                &coverage_period)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
         .flag("fit", "print least-squares charge coefficients", &fit)
         .flag("verbose", "one line per cycle", &verbose)
-        .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start", &oracle)
+        .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start",
+              &oracle)
         .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels);
     if (!p.parse(argc, argv)) return 0;
+    // run_time_to_85 is read off these samples, so without them the figure would silently be -1.
+    if (!(coverage_period > 0)) throw ArgError("--coverage-period: must be positive");
     if (!planner_name.empty()) overrides.push_back("planner=" + planner_name);
     if (samples > 0) overrides.push_back("sampling.samples=" + std::to_string(samples));
     PlannerConfig config = load_config<PlannerConfig>(config_file, overrides);
@@ -192,7 +199,7 @@ int main(int argc, char** argv) {
       ExplorationSimOptions o;
       o.max_time = max_time;
       o.semantic_weight = semantic_weight;
-      o.coverage_period = 1.0;
+      o.coverage_period = coverage_period;
       if (oracle) {
         std::vector<semx::mapper::VoxelKey> keys;
         const double r = world->resolution();
