@@ -62,9 +62,9 @@ struct Group {
     for (const auto* r : runs) v.push_back(r->*field);
     return stat_of(v);
   }
-  // Time_r (or another optional time) over the runs that reached its threshold; `reached` of
+  // A time to a threshold (Time_r, Time_o) over the runs that reached it; `reached` of
   // `runs.size()` did.
-  Stat time_r(int* reached, std::optional<double> BenchRun::*field = &BenchRun::time_r_s) const {
+  Stat reached_time(std::optional<double> BenchRun::*field, int* reached) const {
     std::vector<double> v;
     for (const auto* r : runs)
       if (r->*field) v.push_back(*(r->*field));
@@ -78,9 +78,9 @@ struct Group {
   }
 };
 
-std::string time_r_cell(const Group& g, std::optional<double> BenchRun::*field = &BenchRun::time_r_s) {
+std::string reached_time_cell(const Group& g, std::optional<double> BenchRun::*field) {
   int reached = 0;
-  const Stat s = g.time_r(&reached, field);
+  const Stat s = g.reached_time(field, &reached);
   if (reached == 0) return "N/A";
   std::string cell = pm(s);
   if (reached < static_cast<int>(g.runs.size()))
@@ -258,7 +258,7 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       if (g.runs.empty()) continue;
       md << "| " << w << " | " << n << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
          << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
-         << " | " << time_r_cell(g) << " | " << g.collisions() << " |\n";
+         << " | " << reached_time_cell(g, &BenchRun::time_r_s) << " | " << g.collisions() << " |\n";
     }
   }
 
@@ -274,8 +274,8 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       const Group g = select(runs, w, p, o.comparison_samples);
       md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
          << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
-         << " | " << time_r_cell(g) << " | " << g.collisions() << " | " << time_r_cell(g, &BenchRun::time_o_s)
-         << " |\n";
+         << " | " << reached_time_cell(g, &BenchRun::time_r_s) << " | " << g.collisions() << " | "
+         << reached_time_cell(g, &BenchRun::time_o_s) << " |\n";
     }
   }
 
@@ -292,7 +292,7 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       runs, o, [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
         auto margin = [&](std::optional<double> BenchRun::*field, const char* threshold) {
           int ro = 0, rt = 0;
-          const Stat so = ours.time_r(&ro, field), st = theirs.time_r(&rt, field);
+          const Stat so = ours.reached_time(field, &ro), st = theirs.reached_time(field, &rt);
           if (ro > 0 && rt > 0) return pct(so.mean, st.mean);
           return ro > 0   ? "only ours reached " + std::string(threshold)
                  : rt > 0 ? "only theirs reached " + std::string(threshold)
