@@ -203,15 +203,16 @@ TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
   for (int i = 0; i < 600; ++i) {
     const Eigen::Vector3d p(pos(rng), pos(rng), height(rng));
     const double v = c.esdf(p, config.clearance);
-    const bool node = box_free(p, body) && v >= config.clearance;
+    const bool body_free = box_free(p, body);
+    const bool node = body_free && v >= config.clearance;
     const bool passage = box_free(p, bare) && c.esdf(p, config.door_clearance) >= config.door_clearance;
     c.reset_counters();
     EXPECT_EQ(c.node_free(p), node) << p.transpose();
     // Box first, then the ESDF when the box is free: 1 or 2 checks.
-    EXPECT_EQ(c.box_checks(), box_free(p, body) ? 2 : 1) << p.transpose();
+    EXPECT_EQ(c.box_checks(), body_free ? 2 : 1) << p.transpose();
     EXPECT_EQ(c.passage_free(p), passage) << p.transpose();
     free_nodes += node;
-    blocked_by_box += !box_free(p, body) && v >= config.clearance;
+    blocked_by_box += !body_free && v >= config.clearance;
   }
   // Both outcomes occur, and the box decides some points the clearance alone would pass.
   EXPECT_GT(free_nodes, 50);
@@ -231,8 +232,9 @@ TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
     u.normalize();
     const Eigen::Vector3d p = voxel + dist(rng) * u;
     const bool box = box_free_in(one, p, body);
-    EXPECT_EQ(c.node_free(p), box && c.esdf(p, config.clearance) >= config.clearance) << p.transpose();
-    corner_hits += !box && c.esdf(p, config.clearance) >= body.norm();
+    const double v = c.esdf(p, config.clearance);
+    EXPECT_EQ(c.node_free(p), box && v >= config.clearance) << p.transpose();
+    corner_hits += !box && v >= body.norm();
   }
   EXPECT_GT(corner_hits, 0);  // the box's corners reach the voxel farther than its half diagonal
 }
