@@ -18,24 +18,6 @@ int64_t micros(double seconds) { return static_cast<int64_t>(std::llround(second
 
 }  // namespace
 
-const char* to_string(ControllerState s) {
-  switch (s) {
-    case ControllerState::kIdle:
-      return "IDLE";
-    case ControllerState::kTracking:
-      return "TRACKING";
-    case ControllerState::kBraking:
-      return "BRAKING";
-    case ControllerState::kHolding:
-      return "HOLDING";
-    case ControllerState::kStaleInput:
-      return "STALE_INPUT";
-    case ControllerState::kRejected:
-      return "REJECTED";
-  }
-  return "?";
-}
-
 Controller::Controller(const ControllerConfig& config)
     : config_(config), generator_(config), tracker_(config.tracking) {}
 

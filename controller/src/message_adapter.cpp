@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "semx/controller/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::controller {
 namespace {
@@ -74,7 +74,7 @@ VehicleState to_vehicle_state(const semx::odometry_t& m) {
   s.utime = m.utime;
   s.position = Eigen::Vector3d(m.position[0], m.position[1], m.position[2]);
   s.velocity = Eigen::Vector3d(m.velocity[0], m.velocity[1], m.velocity[2]);
-  s.yaw = yaw_of_quaternion(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]);
+  s.yaw = core::yaw_of_quaternion(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]);
   return s;
 }
 
@@ -85,7 +85,7 @@ semx::control_cmd_t to_message(const Command& c, int64_t utime) {
   m.mode = velocity ? semx::control_cmd_t::VELOCITY : semx::control_cmd_t::HOLD;
   for (int a = 0; a < 3; ++a) m.setpoint[a] = velocity ? c.velocity[a] : 0.0;
   m.yaw_mode = semx::control_cmd_t::YAW_ANGLE;
-  m.yaw = wrap_angle(c.yaw);
+  m.yaw = core::wrap_angle(c.yaw);
   m.yaw_rate = c.yaw_rate;
   return m;
 }

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "semx/controller/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::controller {
 namespace {
@@ -55,7 +55,7 @@ std::vector<Eigen::Vector3d> flight_polyline(const Path& path, const Eigen::Vect
   std::vector<Eigen::Vector3d> pts{vehicle};
   std::vector<double> ys{vehicle_yaw};
   for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
-    const double yaw = unwrap_near(path.yaws[i], ys.back());
+    const double yaw = core::unwrap_near(path.yaws[i], ys.back());
     if ((path.waypoints[i] - pts.back()).norm() < kRepeat) {
       ys.back() = yaw;  // the later heading wins
       continue;
@@ -65,7 +65,7 @@ std::vector<Eigen::Vector3d> flight_polyline(const Path& path, const Eigen::Vect
   }
   // A one-waypoint path is a goal, not a start: fly to it.
   if (path.waypoints.size() == 1) {
-    const double yaw = unwrap_near(path.yaws[0], vehicle_yaw);
+    const double yaw = core::unwrap_near(path.yaws[0], vehicle_yaw);
     if ((path.waypoints[0] - vehicle).norm() < kRepeat) {
       ys.back() = yaw;
     } else {

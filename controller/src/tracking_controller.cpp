@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "semx/controller/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::controller {
 
@@ -23,7 +23,7 @@ Command TrackingController::track(const TrajectoryPoint& ref, const VehicleState
   c.velocity = limit(ref.velocity + config_.accel_feedforward * ref.acceleration +
                      config_.position_gain * (ref.position - vehicle.position) +
                      config_.velocity_gain * (ref.velocity - vehicle.velocity));
-  c.yaw = wrap_angle(ref.yaw + config_.yaw_feedforward * ref.yaw_rate);
+  c.yaw = core::wrap_angle(ref.yaw + config_.yaw_feedforward * ref.yaw_rate);
   c.yaw_rate = ref.yaw_rate;
   return c;
 }
@@ -34,14 +34,14 @@ Command TrackingController::hold_at(const Eigen::Vector3d& position, double yaw,
   c.mode = Command::Mode::kVelocity;
   c.velocity =
       limit(config_.position_gain * (position - vehicle.position) - config_.velocity_gain * vehicle.velocity);
-  c.yaw = wrap_angle(yaw);
+  c.yaw = core::wrap_angle(yaw);
   return c;
 }
 
 Command TrackingController::hover(double yaw) {
   Command c;
   c.mode = Command::Mode::kHold;
-  c.yaw = wrap_angle(yaw);
+  c.yaw = core::wrap_angle(yaw);
   return c;
 }
 

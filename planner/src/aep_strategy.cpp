@@ -3,9 +3,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/travel_cost.hpp"
-#include "stopwatch.hpp"
+#include "semx/core/stopwatch.hpp"
 
 namespace semx::planner {
 
@@ -69,7 +69,7 @@ void AepStrategy::gain_of(PlanContext& ctx, TreeNode& n) {
     }
     cache_.remove_node(near.front());
   }
-  Stopwatch w;
+  core::Stopwatch w;
   GainStats stats;
   n.gain = gains_.evaluate(*ctx.grid, n.position, &stats);
   ctx.counters->gain_evaluations += stats.evaluations;
@@ -109,7 +109,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
   };
   for (int i = 0; i < attempts && kept < s.samples; ++i) {
     ++ctx.counters->samples_drawn;
-    Stopwatch sw;
+    core::Stopwatch sw;
     const Eigen::Vector3d c = ctx.pose.position;
     double z_lo = std::max(c.z() - s.local_height, s.z_min), z_hi = std::min(c.z() + s.local_height, s.z_max);
     if (!(z_lo <= z_hi)) z_lo = s.z_min, z_hi = s.z_max;
@@ -125,7 +125,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     ctx.counters->sample_ms += sw.ms();
     if (!node_ok) continue;
 
-    Stopwatch cw;
+    core::Stopwatch cw;
     // Choose the parent of least cost among the near nodes (RRT*).
     std::vector<int> near_set;
     for (size_t j = 0; j < tree_.size(); ++j) {
@@ -182,14 +182,14 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     ++ctx.counters->edges_added;
   }
 
-  Stopwatch sw;
+  core::Stopwatch sw;
   double best_value = -1.0, best_gain = 0.0;
   for (size_t i = 0; i < tree_.size(); ++i) {
     TreeNode& t = tree_[i];
     t.value = t.gain.gain * std::exp(-a.lambda * t.cost);
     best_gain = std::max(best_gain, t.gain.gain);
     if (t.gain.gain < config_.gain.min_gain) continue;
-    if (i == 0 && yaw_distance(ctx.pose.yaw, t.gain.yaw) < config_.loop.yaw_tolerance) continue;
+    if (i == 0 && core::yaw_distance(ctx.pose.yaw, t.gain.yaw) < config_.loop.yaw_tolerance) continue;
     if (t.value > best_value) {
       best_value = t.value;
       best_ = static_cast<int>(i);

@@ -7,10 +7,10 @@
 #include <sstream>
 #include <utility>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/travel_cost.hpp"
 #include "semx/runtime/semantic_classes.hpp"
-#include "stopwatch.hpp"
+#include "semx/core/stopwatch.hpp"
 
 namespace semx::planner {
 
@@ -179,7 +179,7 @@ int64_t DepStrategy::insert_root(PlanContext& ctx) {
 }
 
 int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
-  Stopwatch sample_watch;
+  core::Stopwatch sample_watch;
   // A draw too close to a wall is moved away from it (centred in a doorway) rather than dropped.
   // Where even the middle is too narrow for a node (a doorway mapped 0.9 m wide), the draw is
   // centred again with the passage clearance and kept as a passage node: a waypoint edges can
@@ -199,7 +199,7 @@ int64_t DepStrategy::try_insert(PlanContext& ctx, const Eigen::Vector3d& draw) {
   ok = ok && ctx.grid->state(p) == VoxelState::kFree && !graph_.any_within(p, spacing);
   ctx.counters->sample_ms += sample_watch.ms();
   if (!ok) return -1;
-  Stopwatch connect_watch;
+  core::Stopwatch connect_watch;
   const std::vector<std::pair<int64_t, double>> links = free_links(ctx, p);
   int64_t id = links.empty() ? -1 : add_linked_node(ctx, p, passage, links);
   if (passage) id = add_approaches(ctx, p, id);
@@ -251,7 +251,7 @@ int64_t DepStrategy::add_approaches(PlanContext& ctx, const Eigen::Vector3d& p, 
   double best = -1.0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
   for (int k = 0; k < kHeadings; ++k) {
-    const double a = kPi * k / kHeadings;
+    const double a = core::kPi * k / kHeadings;
     const Eigen::Vector3d u(std::cos(a), std::sin(a), 0.0);
     double v = 1.0;
     for (double t = 0.1; t <= 0.6 + 1e-9 && v > best; t += 0.1)
@@ -374,7 +374,7 @@ void DepStrategy::bridge(PlanContext& ctx) {
 }
 
 void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
-  Stopwatch w;
+  core::Stopwatch w;
   GainStats stats;
   RoadmapNode& n = graph_.node(id);
   n.gain = gains_.evaluate(*ctx.grid, n.position, &stats);
@@ -391,7 +391,7 @@ DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, i
   const double reward = reward_at(ctx, n.position, n.gain.yaw);
   const double d = search_.distance[static_cast<size_t>(id)];
   View v{n.gain.yaw, n.gain.gain, reward,
-         score(n.gain.gain, reward, d, yaw_distance(ctx.pose.yaw, n.gain.yaw))};
+         score(n.gain.gain, reward, d, core::yaw_distance(ctx.pose.yaw, n.gain.yaw))};
   if (!sweep) return v;
   // The camera sees while it turns (the controller turns on the way, travel_cost.hpp): a turn is
   // worth what it sweeps, and the yaw that sweeps the most per second of flight is the node's.
@@ -404,7 +404,7 @@ DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, i
   v.score = -1.0;
   for (int j = 0; j < gains_.bins(); ++j) {
     const double yaw = gains_.window_yaw(j);
-    const double turn = yaw_distance(ctx.pose.yaw, yaw);
+    const double turn = core::yaw_distance(ctx.pose.yaw, yaw);
     const double g = sweeps_[static_cast<size_t>(j)];
     const double s = score(g, reward, d, turn);
     const double window = gains_.gain_at_yaw(n.gain, yaw);
@@ -462,7 +462,7 @@ void DepStrategy::update_region_factors(PlanContext& ctx) {
 
 bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id, double yaw) const {
   return search_.distance[static_cast<size_t>(id)] < config_.loop.goal_tolerance &&
-         yaw_distance(ctx.pose.yaw, yaw) < config_.loop.yaw_tolerance;
+         core::yaw_distance(ctx.pose.yaw, yaw) < config_.loop.yaw_tolerance;
 }
 
 DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t id) const {
@@ -477,7 +477,7 @@ DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t i
 Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason, int64_t* unreachable,
                               bool sweep) {
   {
-    Stopwatch w;
+    core::Stopwatch w;
     search_ = graph_.shortest_paths(root_);
     ctx.counters->search_settled += search_.settled;
     ctx.counters->search_ms += w.ms();
@@ -532,8 +532,8 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
       if (f->held) {
         // From the vehicle's yaw: the first waypoint (the vehicle) holds one too when the doorway
         // is the next.
-        double turn = yaw_distance(ctx.pose.yaw, f->yaws.front());
-        for (size_t i = 1; i < f->yaws.size(); ++i) turn += yaw_distance(f->yaws[i - 1], f->yaws[i]);
+        double turn = core::yaw_distance(ctx.pose.yaw, f->yaws.front());
+        for (size_t i = 1; i < f->yaws.size(); ++i) turn += core::yaw_distance(f->yaws[i - 1], f->yaws[i]);
         const size_t i = static_cast<size_t>(id);
         const double flown = score(view_gain_[i], reward_[i], search_.distance[i], turn);
         if (flown < score_[i] - 1e-9) {
@@ -612,7 +612,7 @@ void DepStrategy::sample(PlanContext& ctx, double frontier_fraction, int attempt
   int kept = 0;
   for (int64_t i = 0; i < draws && checked < checks && kept < config_.sampling.samples; ++i) {
     ++ctx.counters->samples_drawn;
-    Stopwatch w;
+    core::Stopwatch w;
     const Eigen::Vector3d p = sampler_.draw(*ctx.rng, ctx.pose.position, clusters, frontier_fraction);
     const bool free = ctx.grid->state(p) == VoxelState::kFree;
     ctx.counters->sample_ms += w.ms();
@@ -709,14 +709,14 @@ std::vector<double> interpolate_yaws(const std::vector<Eigen::Vector3d>& w, doub
   if (w.size() < 2) return yaws;
   double total = 0.0;
   for (size_t i = 1; i < w.size(); ++i) total += (w[i] - w[i - 1]).norm();
-  const double turn = wrap_angle(goal_yaw - start_yaw);
+  const double turn = core::wrap_angle(goal_yaw - start_yaw);
   double along = 0.0;
-  yaws[0] = wrap_angle(start_yaw);
+  yaws[0] = core::wrap_angle(start_yaw);
   for (size_t i = 1; i < w.size(); ++i) {
     along += (w[i] - w[i - 1]).norm();
-    yaws[i] = wrap_angle(start_yaw + (total > 0 ? along / total : 1.0) * turn);
+    yaws[i] = core::wrap_angle(start_yaw + (total > 0 ? along / total : 1.0) * turn);
   }
-  yaws.back() = wrap_angle(goal_yaw);
+  yaws.back() = core::wrap_angle(goal_yaw);
   return yaws;
 }
 

@@ -5,29 +5,11 @@
 #include <limits>
 #include <sstream>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/charge_model.hpp"
-#include "stopwatch.hpp"
+#include "semx/core/stopwatch.hpp"
 
 namespace semx::planner {
-
-const char* to_string(PlannerState s) {
-  switch (s) {
-    case PlannerState::kInit:
-      return "INIT";
-    case PlannerState::kPlanning:
-      return "PLANNING";
-    case PlannerState::kExecuting:
-      return "EXECUTING";
-    case PlannerState::kRecovering:
-      return "RECOVERING";
-    case PlannerState::kDone:
-      return "DONE";
-    case PlannerState::kFailed:
-      return "FAILED";
-  }
-  return "?";
-}
 
 ExplorationPlanner::ExplorationPlanner(const PlannerConfig& config)
     : config_(config),
@@ -100,7 +82,7 @@ void ExplorationPlanner::on_controller_status(ControllerState state, int64_t pla
 void ExplorationPlanner::track_arrival(int64_t utime) {
   const bool within =
       goal_.valid && pose_ && (pose_->position - goal_.position).norm() <= config_.loop.goal_tolerance &&
-      (controller_holding_ || yaw_distance(pose_->yaw, goal_.yaw) <= config_.loop.yaw_tolerance);
+      (controller_holding_ || core::yaw_distance(pose_->yaw, goal_.yaw) <= config_.loop.yaw_tolerance);
   if (!within) {
     arrived_utime_ = -1;
   } else if (arrived_utime_ < 0) {
@@ -135,7 +117,7 @@ void ExplorationPlanner::add_unobservable(const std::vector<mapper::VoxelKey>& k
 
 void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
   if (!grid_ || !pose_) return;
-  Stopwatch w;
+  core::Stopwatch w;
   std::vector<mapper::VoxelKey> keys;
   GainStats stats;
   gains_.set_ignored(&unobservable_);
@@ -248,7 +230,7 @@ int64_t ExplorationPlanner::quiet_until(int64_t utime) const {
 }
 
 void ExplorationPlanner::run_cycle(int64_t utime) {
-  Stopwatch total;
+  core::Stopwatch total;
   CycleCounters c;
   ++iteration_;
   checker_.reset_counters();

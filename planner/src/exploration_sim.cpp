@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::planner {
 
@@ -79,14 +79,14 @@ void ExplorationSim::move(double dt) {
     const double target_yaw = path_.yaws[next_waypoint_];
     const Eigen::Vector3d d = w - pose_.position;
     const double dist = d.norm();
-    const double turn = wrap_angle(target_yaw - pose_.yaw);
+    const double turn = core::wrap_angle(target_yaw - pose_.yaw);
     // Position and yaw move together toward the waypoint; the yaw may finish after the position.
     const double step = std::min(budget, dist);
     if (dist > 1e-9) pose_.position += d * (step / dist);
     distance_ += step;
     budget -= step;
     const double yaw_step = std::clamp(turn, -yaw_budget, yaw_budget);
-    pose_.yaw = wrap_angle(pose_.yaw + yaw_step);
+    pose_.yaw = core::wrap_angle(pose_.yaw + yaw_step);
     yaw_budget -= std::abs(yaw_step);
     if (dist - step < 1e-9 && std::abs(turn - yaw_step) < 1e-6) {
       ++next_waypoint_;

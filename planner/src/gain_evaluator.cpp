@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "semx/mapper/raycast.hpp"
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::planner {
 
@@ -25,26 +25,26 @@ int64_t NodeGain::total_voxels() const {
 
 GainEvaluator::GainEvaluator(const GainConfig& config) : config_(config) {
   const int bins = config_.yaw_bins;
-  window_ = std::clamp(static_cast<int>(std::lround(config_.horizontal_fov() / (2.0 * kPi / bins))), 1, bins);
+  window_ = std::clamp(static_cast<int>(std::lround(config_.horizontal_fov() / (2.0 * core::kPi / bins))), 1, bins);
   const double half_vfov = 0.5 * config_.vertical_fov();
   // The image's vertical extent shrinks off-axis: at horizontal angle a from the optical axis a
   // pixel row sees elevations up to atan(tan(vfov/2) cos a). Counting only what every column of
   // the window sees (a = hfov/2) keeps the model conservative: a voxel counted for a window is
   // seen when the camera looks along that window's centre (up to occlusion).
-  tan_half_vfov_ = std::tan(half_vfov) * std::cos(std::min(0.5 * config_.horizontal_fov(), 0.5 * kPi - 1e-6));
+  tan_half_vfov_ = std::tan(half_vfov) * std::cos(std::min(0.5 * config_.horizontal_fov(), 0.5 * core::kPi - 1e-6));
   const int na = config_.rays_azimuth, ne = config_.rays_elevation;
   directions_.reserve(static_cast<size_t>(na) * ne);
   for (int e = 0; e < ne; ++e) {
     const double max_el = std::atan(tan_half_vfov_);
     const double el = ne == 1 ? 0.0 : -max_el + 2.0 * max_el * e / (ne - 1);
     for (int a = 0; a < na; ++a) {
-      const double az = -kPi + (a + 0.5) * 2.0 * kPi / na;
+      const double az = -core::kPi + (a + 0.5) * 2.0 * core::kPi / na;
       directions_.emplace_back(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
       direction_bin_.push_back(bin_of(az));
     }
   }
   for (int b = 0; b < bins; ++b) {
-    const double a = -kPi + b * bin_width();
+    const double a = -core::kPi + b * bin_width();
     bin_boundary_.emplace_back(std::cos(a), std::sin(a));
   }
 }
@@ -73,12 +73,12 @@ int GainEvaluator::bin_near(const Eigen::Vector3d& c, int b) const {
   return bin_of(std::atan2(c.y(), c.x()));
 }
 
-double GainEvaluator::bin_width() const { return 2.0 * kPi / config_.yaw_bins; }
+double GainEvaluator::bin_width() const { return 2.0 * core::kPi / config_.yaw_bins; }
 
-double GainEvaluator::window_yaw(int j) const { return wrap_angle(-kPi + (j + 0.5 * window_) * bin_width()); }
+double GainEvaluator::window_yaw(int j) const { return core::wrap_angle(-core::kPi + (j + 0.5 * window_) * bin_width()); }
 
 int GainEvaluator::bin_of(double azimuth) const {
-  const int b = static_cast<int>(std::floor((azimuth + kPi) / bin_width()));
+  const int b = static_cast<int>(std::floor((azimuth + core::kPi) / bin_width()));
   return std::clamp(b, 0, config_.yaw_bins - 1);
 }
 
@@ -144,7 +144,7 @@ void GainEvaluator::finish(NodeGain& g) const {
 int GainEvaluator::window_of(double yaw) const {
   // Window j is centred at -pi + (j + W/2) * width.
   const int bins = config_.yaw_bins;
-  const int j = static_cast<int>(std::lround((wrap_angle(yaw) + kPi) / bin_width() - 0.5 * window_));
+  const int j = static_cast<int>(std::lround((core::wrap_angle(yaw) + core::kPi) / bin_width() - 0.5 * window_));
   return ((j % bins) + bins) % bins;
 }
 
@@ -169,8 +169,8 @@ void GainEvaluator::sweep_gains(const NodeGain& g, double from_yaw, std::vector<
   const int from = window_of(from_yaw);
   for (int j = 0; j < bins; ++j) {
     // Counter-clockwise (increasing bins) from `from` to j, or clockwise from j to `from`; at a
-    // half turn either way, as the path's yaws take it (wrap_angle).
-    const bool ccw = wrap_angle(window_yaw(j) - window_yaw(from)) >= 0.0;
+    // half turn either way, as the path's yaws take it (core::wrap_angle).
+    const bool ccw = core::wrap_angle(window_yaw(j) - window_yaw(from)) >= 0.0;
     const int start = ccw ? from : j;
     const int span = std::min(bins, ((ccw ? j - from : from - j) % bins + bins) % bins + window_);
     out[static_cast<size_t>(j)] =

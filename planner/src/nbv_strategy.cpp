@@ -3,9 +3,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/travel_cost.hpp"
-#include "stopwatch.hpp"
+#include "semx/core/stopwatch.hpp"
 
 namespace semx::planner {
 
@@ -56,7 +56,7 @@ NbvStrategy::NbvStrategy(const PlannerConfig& config)
     : config_(config), checker_(config.collision), gains_(config.gain) {}
 
 void NbvStrategy::evaluate(PlanContext& ctx, TreeNode& n) {
-  Stopwatch w;
+  core::Stopwatch w;
   GainStats stats;
   n.gain = gains_.evaluate(*ctx.grid, n.position, &stats);
   ctx.counters->gain_evaluations += stats.evaluations;
@@ -82,7 +82,7 @@ PlanOutcome NbvStrategy::plan(PlanContext& ctx) {
   int kept = 0;
   for (int i = 0; i < attempts && kept < s.samples; ++i) {
     ++ctx.counters->samples_drawn;
-    Stopwatch sw;
+    core::Stopwatch sw;
     const Eigen::Vector3d c = ctx.pose.position;
     const double r = config_.nbv.radius;
     double z_lo = std::max(c.z() - s.local_height, s.z_min), z_hi = std::min(c.z() + s.local_height, s.z_max);
@@ -99,7 +99,7 @@ PlanOutcome NbvStrategy::plan(PlanContext& ctx) {
     const bool node_ok = checker_.centre(p);  // moved off a wall when too close (as DEP's draws)
     ctx.counters->sample_ms += sw.ms();
     if (!node_ok) continue;
-    Stopwatch cw;
+    core::Stopwatch cw;
     ++ctx.counters->edges_checked;
     const bool edge_ok = near == 0 ? checker_.root_edge_free(from, p) : checker_.edge_free(from, p);
     ctx.counters->connect_ms += cw.ms();
@@ -118,12 +118,12 @@ PlanOutcome NbvStrategy::plan(PlanContext& ctx) {
 
   PlanOutcome out;
   // The best branch by value, among nodes whose own gain makes them worth visiting.
-  Stopwatch sw;
+  core::Stopwatch sw;
   double best_value = -1.0, best_gain = 0.0;
   for (size_t i = 0; i < tree_.size(); ++i) {
     best_gain = std::max(best_gain, tree_[i].gain.gain);
     if (tree_[i].gain.gain < config_.gain.min_gain) continue;
-    if (i == 0 && yaw_distance(ctx.pose.yaw, tree_[0].gain.yaw) < config_.loop.yaw_tolerance) continue;
+    if (i == 0 && core::yaw_distance(ctx.pose.yaw, tree_[0].gain.yaw) < config_.loop.yaw_tolerance) continue;
     if (tree_[i].value > best_value) {
       best_value = tree_[i].value;
       best_ = static_cast<int>(i);

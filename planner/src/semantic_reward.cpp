@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::planner {
 
@@ -15,7 +15,7 @@ double region_reward(const Eigen::Vector3d& p, const SemanticRegion& s, const Vi
   if (d > s.radius) return 0.0;
   if (view) {
     const Eigen::Vector3d to = s.centroid - p;
-    if (std::abs(wrap_angle(std::atan2(to.y(), to.x()) - view->yaw)) > view->half_fov) return 0.0;
+    if (std::abs(core::wrap_angle(std::atan2(to.y(), to.x()) - view->yaw)) > view->half_fov) return 0.0;
   }
   return s.weight * (1.0 - d / s.radius);
 }

@@ -27,7 +27,7 @@
 #include "semx/planner/exploration_planner.hpp"
 #include "semx/planner/exploration_sim.hpp"
 #include "semx/planner/gain_evaluator.hpp"
-#include "semx/planner/rng.hpp"
+#include "semx/core/random.hpp"
 #include "semx/planner/synthetic_world.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
@@ -64,7 +64,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 // The kernels on one map, at points drawn from its free voxels (fixed seed).
 void time_kernels(const mapper::StateGrid& grid, const PlannerConfig& config) {
-  Rng rng(1);
+  semx::core::SplitMixRng rng(1);
   const mapper::KeyBox box = grid.known_bounds();
   const double res = grid.resolution();
   std::vector<Eigen::Vector3d> points;

@@ -2,16 +2,12 @@
 
 #include <cmath>
 
+#include "semx/core/angles.hpp"
 #include "semx/runtime/pinhole_camera.hpp"
 #include "semx/simulator/collision.hpp"
 
 namespace semx::simulator {
 namespace {
-
-double wrap_angle(double a) {
-  a = std::remainder(a, 2.0 * M_PI);
-  return a <= -M_PI ? a + 2.0 * M_PI : a;
-}
 
 Eigen::Vector3d limit_velocity(Eigen::Vector3d v, const VehicleConfig& c) {
   const double xy = v.head<2>().norm();
@@ -81,7 +77,7 @@ Eigen::Isometry3d VehicleState::camera_pose() const {
 Quadrotor::Quadrotor(const World& world, const VehicleConfig& config) : world_(world), config_(config) {
   for (const auto& s : world.solids) solid_bounds_.push_back(s.bounds());
   state_.position = world.start.position;
-  state_.yaw = wrap_angle(world.start.yaw);
+  state_.yaw = core::wrap_angle(world.start.yaw);
   hold_position_ = state_.position;
 }
 
@@ -159,12 +155,12 @@ StepReport Quadrotor::step(double dt) {
   const Eigen::Vector3d p = prev.position + 0.5 * (prev.velocity + v) * dt;
 
   double rate_cmd = cmd_.yaw_mode == ControlCommand::kYawRate ? cmd_.yaw_rate
-                                                              : c.yaw_gain * wrap_angle(cmd_.yaw - prev.yaw);
+                                                              : c.yaw_gain * core::wrap_angle(cmd_.yaw - prev.yaw);
   if (cmd_.mode == ControlCommand::kHold) rate_cmd = 0;
   rate_cmd = std::clamp(rate_cmd, -c.max_yaw_rate, c.max_yaw_rate);
   const double alpha = std::min(1.0, dt / c.yaw_time_constant);
   const double yaw_rate = prev.yaw_rate + alpha * (rate_cmd - prev.yaw_rate);
-  const double yaw = wrap_angle(prev.yaw + 0.5 * (prev.yaw_rate + yaw_rate) * dt);
+  const double yaw = core::wrap_angle(prev.yaw + 0.5 * (prev.yaw_rate + yaw_rate) * dt);
 
   const int hit = body_hit(p, yaw);
   if (hit >= 0) {

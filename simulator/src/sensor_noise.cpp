@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "semx/runtime/semantic_classes.hpp"
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 
 namespace semx::simulator {
 
@@ -31,7 +31,7 @@ void load(runtime::ConfigMap& m, DetectionNoiseConfig& c) {
 
 void apply_depth_noise(Image<uint16_t>& depth, const DepthNoiseConfig& config, uint64_t seed) {
   if (!config.enabled) return;
-  Rng rng(seed);
+  core::XoshiroRng rng(seed);
   for (auto& d : depth.data) {
     if (d == runtime::kDepthInvalid || d == runtime::kDepthNoReturn) continue;
     if (config.dropout > 0 && rng.bernoulli(config.dropout)) {
@@ -59,7 +59,7 @@ std::vector<uint16_t> object_classes() {
 void apply_detection_noise(CameraFrame& frame, const DetectionNoiseConfig& config, uint64_t seed) {
   if (!config.enabled || frame.class_label.empty()) return;
   static const std::vector<uint16_t> kObjects = object_classes();
-  Rng rng(seed);
+  core::XoshiroRng rng(seed);
   auto& cls = frame.class_label.data;
   auto& inst = frame.instance_label.data;
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 
 namespace semx::simulator {
 namespace {
@@ -52,7 +52,7 @@ void load(runtime::ConfigMap& m, SimulatorConfig& c) {
 Simulator::Simulator(World world, const SimulatorConfig& config)
     : world_(std::make_unique<World>(std::move(world))),
       config_(config),
-      imu_(config.imu, mix_seed(config.seed, kImuStream)) {
+      imu_(config.imu, core::mix_seed(config.seed, kImuStream)) {
   vehicle_ = std::make_unique<Quadrotor>(*world_, config_.vehicle);
   RasterizerOptions ro;
   ro.mesh.cylinder_segments = config_.cylinder_segments;
@@ -117,11 +117,11 @@ void Simulator::render_camera(CameraFrame& out, unsigned channels) {
   out.frame_id = camera_count_;
   const uint64_t id = static_cast<uint64_t>(camera_count_);
   if (channels & kRenderDepth) {
-    apply_depth_noise(out.depth, config_.depth_noise, mix_seed(mix_seed(config_.seed, kDepthStream), id));
+    apply_depth_noise(out.depth, config_.depth_noise, core::mix_seed(core::mix_seed(config_.seed, kDepthStream), id));
   }
   if (channels & kRenderLabels) {
     apply_detection_noise(out, config_.detection_noise,
-                          mix_seed(mix_seed(config_.seed, kDetectionStream), id));
+                          core::mix_seed(core::mix_seed(config_.seed, kDetectionStream), id));
   }
 }
 

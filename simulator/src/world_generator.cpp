@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 
 namespace semx::simulator {
 namespace {
@@ -40,7 +40,7 @@ struct Item {
 
 class Builder {
  public:
-  Builder(const GeneratorOptions& o, uint64_t attempt) : o_(o), rng_(mix_seed(o.seed, attempt)) {}
+  Builder(const GeneratorOptions& o, uint64_t attempt) : o_(o), rng_(core::mix_seed(o.seed, attempt)) {}
 
   bool build(GeneratedWorld& out) {
     const double aspect = rng_.uniform(1.0, 1.6);
@@ -379,7 +379,7 @@ class Builder {
   }
 
   GeneratorOptions o_;
-  Rng rng_;
+  core::XoshiroRng rng_;
   double W_ = 0, D_ = 0;
   std::vector<Rect> rooms_;
   std::vector<Cut> cuts_;

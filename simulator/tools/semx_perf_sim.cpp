@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "semx/simulator/ground_truth.hpp"
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/ray_caster.hpp"
 #include "semx/simulator/simulator.hpp"
@@ -31,7 +31,7 @@ double seconds_since(Clock::time_point t0) {
 std::vector<Eigen::Isometry3d> sample_poses(const sim::World& w, int n, uint64_t seed) {
   const sim::GroundTruth gt(w, 0.1);
   const sim::VehicleReachability vr(gt, w.start.position);
-  sim::Rng rng(seed);
+  semx::core::XoshiroRng rng(seed);
   std::vector<Eigen::Isometry3d> poses;
   const Eigen::Vector3d lo = w.bounds.min, hi = w.bounds.max;
   for (int tries = 0; static_cast<int>(poses.size()) < n && tries < 100000; ++tries) {

@@ -20,7 +20,7 @@
 
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/quadrotor.hpp"
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/world.hpp"
 #include "semx/simulator/world_generator.hpp"
@@ -95,7 +95,7 @@ cv::Scalar bgr(const sim::Rgb& c) { return cv::Scalar(c.b, c.g, c.r); }
 
 sim::Rgb instance_color(uint16_t id) {
   if (id == 0) return {0, 0, 0};
-  const uint64_t h = sim::mix_seed(id);
+  const uint64_t h = semx::core::mix_seed(id);
   return {static_cast<uint8_t>(60 + (h & 0xFF) % 196), static_cast<uint8_t>(60 + ((h >> 8) & 0xFF) % 196),
           static_cast<uint8_t>(60 + ((h >> 16) & 0xFF) % 196)};
 }

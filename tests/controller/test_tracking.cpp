@@ -129,5 +129,5 @@ TEST(Tracking, CameraEndsFacingTheLastWaypointsYaw) {
   loop.send_path({{0, 0, 1}, {2, 0, 1}, {2, 2, 1}}, {3.0, -3.0, -2.0}, 1);
   loop.run_until([&] { return loop.controller.status().state == ControllerState::kHolding; }, 60);
   loop.run(2.0);
-  EXPECT_NEAR(wrap_angle(loop.vehicle.yaw - (-2.0)), 0.0, 0.02);
+  EXPECT_NEAR(semx::core::wrap_angle(loop.vehicle.yaw - (-2.0)), 0.0, 0.02);
 }

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "fields.hpp"
-#include "semx/controller/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/controller/fallback.hpp"
 #include "semx/controller/synthetic_scene.hpp"
 #include "semx/controller/time_allocation.hpp"
@@ -62,7 +62,7 @@ Trajectory stops_at_every_point(const FallbackSpline& fb, const std::vector<Eige
 }
 
 std::vector<double> unwrapped(std::vector<double> yaws) {
-  for (std::size_t k = 1; k < yaws.size(); ++k) yaws[k] = unwrap_near(yaws[k], yaws[k - 1]);
+  for (std::size_t k = 1; k < yaws.size(); ++k) yaws[k] = semx::core::unwrap_near(yaws[k], yaws[k - 1]);
   return yaws;
 }
 
@@ -220,7 +220,7 @@ TEST(TrajectoryGeneration, YawTurnsTheShortWayToEachWaypointsHeading) {
   ASSERT_TRUE(r.ok);
   const Trajectory& t = r.trajectory;
   EXPECT_NEAR(t.sample(0).yaw, 3.0, 1e-9);
-  EXPECT_NEAR(wrap_angle(t.end_yaw() - (-1.5)), 0.0, 1e-9);
+  EXPECT_NEAR(semx::core::wrap_angle(t.end_yaw() - (-1.5)), 0.0, 1e-9);
   // Monotone: every sample lies between the start yaw and the next target (no long way round).
   for (double s = 0; s <= t.duration(); s += 0.01) {
     const double y = t.sample(s).yaw;

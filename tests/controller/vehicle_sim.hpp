@@ -6,7 +6,7 @@
 
 #include <memory>
 
-#include "semx/controller/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/controller/controller.hpp"
 
 namespace semx::controller::test {
@@ -31,7 +31,7 @@ struct PointMass {
     velocity = v;
     if (!hold)
       yaw =
-          wrap_angle(yaw + std::clamp(yaw_gain * wrap_angle(c.yaw - yaw), -max_yaw_rate, max_yaw_rate) * dt);
+          core::wrap_angle(yaw + std::clamp(yaw_gain * core::wrap_angle(c.yaw - yaw), -max_yaw_rate, max_yaw_rate) * dt);
   }
 };
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "planner_test_util.hpp"
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/gain_evaluator.hpp"
 
 namespace semx::planner {
@@ -54,7 +54,7 @@ TEST(Gain, CountsEachVoxelKindWithItsWeight) {
   EXPECT_DOUBLE_EQ(r.gain, 1 * 1 + 2 * 26 + 4 * 1);
   EXPECT_EQ(r.total_voxels(), 28);
   // Both clusters are in front (+x): the best window looks that way.
-  EXPECT_LT(yaw_distance(r.yaw, 0.0), e.bin_width());
+  EXPECT_LT(core::yaw_distance(r.yaw, 0.0), e.bin_width());
 
   const NodeGain exact = e.evaluate_exact(g, kNode);
   EXPECT_EQ(exact.counts, r.counts);
@@ -137,7 +137,7 @@ TEST(Gain, RangeAndVerticalFieldOfView) {
   const NodeGain r = e.evaluate(g, kNode);
   EXPECT_EQ(r.total_voxels(), 1);
   EXPECT_EQ(r.counts[1], 1);
-  EXPECT_LT(yaw_distance(r.yaw, kPi), e.bin_width());
+  EXPECT_LT(core::yaw_distance(r.yaw, core::kPi), e.bin_width());
   EXPECT_EQ(e.evaluate_exact(g, kNode).counts, r.counts);
 }
 
@@ -150,17 +150,17 @@ TEST(Gain, YawBinsPickTheRichestWindow) {
   ASSERT_EQ(e.window_bins(), 8);  // 90° of 32 bins
   const NodeGain r = e.evaluate(g, kNode);
   EXPECT_DOUBLE_EQ(r.gain, 106.0);
-  EXPECT_LT(yaw_distance(r.yaw, 0.5 * kPi + 0.13), 2 * e.bin_width());
+  EXPECT_LT(core::yaw_distance(r.yaw, 0.5 * core::kPi + 0.13), 2 * e.bin_width());
   // Looking along +x sees the first cube only; looking at -y nothing.
   EXPECT_DOUBLE_EQ(e.gain_at_yaw(r, 0.0), 53.0);
-  EXPECT_DOUBLE_EQ(e.gain_at_yaw(r, -0.5 * kPi), 0.0);
+  EXPECT_DOUBLE_EQ(e.gain_at_yaw(r, -0.5 * core::kPi), 0.0);
   // Every voxel went to the bin of its azimuth.
   for (int b = 0; b < e.bins(); ++b) {
     const auto& c = r.bin_count[static_cast<size_t>(b)];
     if (c[0] + c[1] + c[2] == 0) continue;
-    const double lo = -kPi + b * e.bin_width(), hi = lo + e.bin_width();
+    const double lo = -core::kPi + b * e.bin_width(), hi = lo + e.bin_width();
     const bool plus_x = lo <= 0.1 && hi >= -0.1;
-    const bool plus_y = lo <= 0.5 * kPi + 0.35 && hi >= 0.5 * kPi - 0.1;
+    const bool plus_y = lo <= 0.5 * core::kPi + 0.35 && hi >= 0.5 * core::kPi - 0.1;
     EXPECT_TRUE(plus_x || plus_y) << "bin " << b;
   }
 }
@@ -184,11 +184,11 @@ TEST(Gain, ATurnSweepsEveryWindowItPassesTheShorterWay) {
   e.sweep_gains(g, e.window_yaw(from), sweep);
   ASSERT_EQ(sweep.size(), 32u);
   // No turn: that window. Counter-clockwise to window 10: bins 4..17. Clockwise to window 30
-  // (6 bins the other way): bins 30..11. Half a turn (window 20): the way wrap_angle gives.
+  // (6 bins the other way): bins 30..11. Half a turn (window 20): the way core::wrap_angle gives.
   EXPECT_DOUBLE_EQ(sweep[4], bins_sum(4, w));
   EXPECT_DOUBLE_EQ(sweep[10], bins_sum(4, 6 + w));
   EXPECT_DOUBLE_EQ(sweep[30], bins_sum(30, 6 + w));
-  const bool ccw = wrap_angle(e.window_yaw(20) - e.window_yaw(4)) >= 0;
+  const bool ccw = core::wrap_angle(e.window_yaw(20) - e.window_yaw(4)) >= 0;
   EXPECT_DOUBLE_EQ(sweep[20], ccw ? bins_sum(4, 16 + w) : bins_sum(20, 16 + w));
   for (int j = 0; j < bins; ++j) {
     EXPECT_DOUBLE_EQ(e.sweep_gain(g, e.window_yaw(from), j), sweep[static_cast<size_t>(j)]);
@@ -200,10 +200,10 @@ TEST(Gain, ATurnSweepsEveryWindowItPassesTheShorterWay) {
 TEST(Gain, BinOfAzimuthAgreesWithAtan2) {
   GainEvaluator e(GainConfig{});
   for (int i = 0; i < 3600; ++i) {
-    const double a = -kPi + (i + 0.37) * 2 * kPi / 3600;
-    EXPECT_EQ(e.bin_of(a), static_cast<int>(std::floor((a + kPi) / e.bin_width()))) << a;
+    const double a = -core::kPi + (i + 0.37) * 2 * core::kPi / 3600;
+    EXPECT_EQ(e.bin_of(a), static_cast<int>(std::floor((a + core::kPi) / e.bin_width()))) << a;
   }
-  EXPECT_EQ(e.bin_of(kPi), e.bins() - 1);
+  EXPECT_EQ(e.bin_of(core::kPi), e.bins() - 1);
   EXPECT_NEAR(e.window_yaw(12), 0.0, 1e-12);  // window 12..19 is centred on +x
 }
 
@@ -230,7 +230,7 @@ TEST(Gain, DefaultRaysSampleWhatTheReferenceCounts) {
   EXPECT_LE(fast.total_voxels(), exact.total_voxels());
   // Rays reach every voxel near the node, a sample of the far ones (about a quarter here).
   EXPECT_GE(fast.total_voxels(), exact.total_voxels() / 6);
-  EXPECT_LT(yaw_distance(fast.yaw, exact.yaw), 3 * e.bin_width());
+  EXPECT_LT(core::yaw_distance(fast.yaw, exact.yaw), 3 * e.bin_width());
   EXPECT_EQ(stats.evaluations, 1);
   EXPECT_EQ(stats.rays, 128 * 10);
   EXPECT_GT(stats.steps, stats.rays);

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "planner_test_util.hpp"
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/exploration_planner.hpp"
@@ -51,14 +51,14 @@ TEST(Planner, PicksTheGoalFacingTheKnownFrontier) {
   mapper::StateGrid g = corridor();
   ExplorationPlanner p(test_config("dep"));
   p.set_map(&g);
-  p.set_pose(pose({1, 2, 1.2}, 0.5 * kPi));
+  p.set_pose(pose({1, 2, 1.2}, 0.5 * core::kPi));
   const auto path = first_path(p, 0, 2000000);
   ASSERT_TRUE(path);
   const Goal& goal = p.goal();
   ASSERT_TRUE(goal.valid);
   EXPECT_GT(goal.position.x(), 3.5);            // toward the frontier, clear of it
   EXPECT_LT(goal.position.x(), 6.1 - 0.45);     // in known free space with the clearance
-  EXPECT_LT(yaw_distance(goal.yaw, 0.0), 0.4);  // looking at it
+  EXPECT_LT(core::yaw_distance(goal.yaw, 0.0), 0.4);  // looking at it
   EXPECT_EQ(path->waypoints.front(), Eigen::Vector3d(1, 2, 1.2));
   EXPECT_EQ(path->waypoints.back(), goal.position);
   EXPECT_EQ(path->yaws.size(), path->waypoints.size());
@@ -72,7 +72,7 @@ struct MirrorScene {
   PlannerConfig config = test_config("semantic-dep");
   mapper::StateGrid grid = mapper::StateGrid(0.1);
   FrontierTracker frontiers{1.0};
-  Rng rng{1};
+  core::SplitMixRng rng{1};
   std::vector<SemanticRegion> regions;
   CycleCounters counters;
   DepStrategy dep{config, true};
@@ -92,7 +92,7 @@ struct MirrorScene {
   Goal choose() {
     PlanContext ctx;
     ctx.grid = &grid;
-    ctx.pose = pose({6.0, 2.05, 1.25}, 0.5 * kPi);
+    ctx.pose = pose({6.0, 2.05, 1.25}, 0.5 * core::kPi);
     ctx.regions = &regions;
     ctx.frontiers = &frontiers;
     ctx.cycle = 1;

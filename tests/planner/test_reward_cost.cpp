@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/travel_cost.hpp"
 
@@ -32,7 +32,7 @@ TEST(SemanticReward, BoundaryCases) {
 TEST(SemanticReward, InViewRewardsOnlyWhatTheNodesYawLooksAt) {
   const SemanticRegion s = region({1, 2, 1}, 30.0, 2.0);
   const Eigen::Vector3d node(2, 2, 1);  // 1 m east of the object: it lies at azimuth 180°
-  const ViewCone west{kPi, 0.25 * kPi}, north{0.5 * kPi, 0.25 * kPi}, edge{0.75 * kPi + 1e-9, 0.25 * kPi};
+  const ViewCone west{core::kPi, 0.25 * core::kPi}, north{0.5 * core::kPi, 0.25 * core::kPi}, edge{0.75 * core::kPi + 1e-9, 0.25 * core::kPi};
   EXPECT_DOUBLE_EQ(region_reward(node, s, &west), 15.0);
   EXPECT_DOUBLE_EQ(region_reward(node, s, &north), 0.0);  // looking away
   EXPECT_DOUBLE_EQ(region_reward(node, s, &edge), 15.0);  // at the edge of the 90° window
@@ -72,8 +72,8 @@ TEST(TravelCost, DistanceOverSpeedPlusWeightedTurn) {
   EXPECT_DOUBLE_EQ(travel_time(4.0, 0.0, c), 2.0);
   EXPECT_DOUBLE_EQ(travel_time(4.0, 1.0, c), 2.0 + 3.0 * 1.0 / 0.5);
   // The turn is the smaller way round: from 3 rad to -3 rad is 2π - 6.
-  EXPECT_NEAR(travel_time(0.0, 3.0, -3.0, c), 3.0 * (2 * kPi - 6.0) / 0.5, 1e-12);
-  EXPECT_NEAR(travel_time(0.0, -kPi + 0.1, kPi - 0.1, c), 3.0 * 0.2 / 0.5, 1e-12);
+  EXPECT_NEAR(travel_time(0.0, 3.0, -3.0, c), 3.0 * (2 * core::kPi - 6.0) / 0.5, 1e-12);
+  EXPECT_NEAR(travel_time(0.0, -core::kPi + 0.1, core::kPi - 0.1, c), 3.0 * 0.2 / 0.5, 1e-12);
   // Floored so the node under the vehicle scores finitely.
   EXPECT_DOUBLE_EQ(travel_time(0.0, 0.0, c), 0.1);
 }
@@ -96,17 +96,17 @@ TEST(TravelCost, TurningWhileFlyingTakesTheLongerOfTheTwo) {
 }
 
 TEST(TravelCost, WrapAngle) {
-  EXPECT_NEAR(wrap_angle(3 * kPi), kPi, 1e-12);
-  EXPECT_NEAR(wrap_angle(-kPi), kPi, 1e-12);
-  EXPECT_NEAR(wrap_angle(2 * kPi + 0.5), 0.5, 1e-12);
-  EXPECT_NEAR(yaw_distance(0.1, -0.1), 0.2, 1e-12);
+  EXPECT_NEAR(core::wrap_angle(3 * core::kPi), core::kPi, 1e-12);
+  EXPECT_NEAR(core::wrap_angle(-core::kPi), core::kPi, 1e-12);
+  EXPECT_NEAR(core::wrap_angle(2 * core::kPi + 0.5), 0.5, 1e-12);
+  EXPECT_NEAR(core::yaw_distance(0.1, -0.1), 0.2, 1e-12);
 }
 
 TEST(Score, OrdersByUtilityOverTime) {
   const CostConfig c;  // v = 1, ω = 1, w_psi = 1, turning while flying
   const double near_small = node_score(100, 0, travel_time(2.0, 0.0, c));  // 50
   const double far_big = node_score(300, 0, travel_time(10.0, 0.0, c));    // 30
-  const double near_turn = node_score(100, 0, travel_time(2.0, kPi, c));   // 100 / π: the turn takes longer
+  const double near_turn = node_score(100, 0, travel_time(2.0, core::kPi, c));   // 100 / π: the turn takes longer
   const double near_small_turn = node_score(100, 0, travel_time(2.0, 1.0, c));  // 50: turned on the way
   const double rewarded = node_score(100, 50, travel_time(2.0, 0.0, c));        // 75
   EXPECT_DOUBLE_EQ(near_small, 50.0);
@@ -114,12 +114,12 @@ TEST(Score, OrdersByUtilityOverTime) {
   EXPECT_GT(near_turn, far_big);
   EXPECT_DOUBLE_EQ(near_small_turn, near_small);
   EXPECT_GT(rewarded, near_small);
-  EXPECT_NEAR(near_turn, 100.0 / kPi, 1e-12);
+  EXPECT_NEAR(near_turn, 100.0 / core::kPi, 1e-12);
   // The paper's sum charges the turn on top of the flight.
   CostConfig sum;
   sum.turn_while_flying = false;
-  EXPECT_NEAR(node_score(100, 0, travel_time(2.0, kPi, sum)), 100.0 / (2.0 + kPi), 1e-12);
-  EXPECT_GT(far_big, node_score(100, 0, travel_time(2.0, kPi, sum)));
+  EXPECT_NEAR(node_score(100, 0, travel_time(2.0, core::kPi, sum)), 100.0 / (2.0 + core::kPi), 1e-12);
+  EXPECT_GT(far_big, node_score(100, 0, travel_time(2.0, core::kPi, sum)));
 }
 
 }  // namespace

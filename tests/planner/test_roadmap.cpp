@@ -9,7 +9,7 @@
 #include <set>
 
 #include "planner_test_util.hpp"
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/roadmap.hpp"
@@ -310,7 +310,7 @@ struct DepFixture {
   PlannerConfig config = test_config("dep");
   mapper::StateGrid grid = mapper::StateGrid(0.1);
   FrontierTracker frontiers{1.0};
-  Rng rng{7};
+  core::SplitMixRng rng{7};
   std::vector<SemanticRegion> regions;
   CycleCounters counters;
 
@@ -477,7 +477,7 @@ TEST(DepRoadmap, PassageNodesGetApproachNodesStraightThroughTheDoorway) {
   w.back() += Eigen::Vector3d(1.0, 1.0, 0.0);  // a goal beyond, off the line
   std::vector<double> yaws = interpolate_yaws(w, 0.0, 1.0);
   dep.hold_heading_through_doorways(path, w, yaws);
-  for (size_t i = 1; i <= 3; ++i) EXPECT_NEAR(yaws[i], kPi / 2, 1e-9) << i;  // +y, through the door
+  for (size_t i = 1; i <= 3; ++i) EXPECT_NEAR(yaws[i], core::kPi / 2, 1e-9) << i;  // +y, through the door
   EXPECT_NEAR(yaws.back(), 1.0, 1e-9);
 }
 
@@ -509,8 +509,8 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
     if (!o.goal.valid) continue;
     ++goals;
     double turn = 0.0;
-    for (size_t i = 1; i < o.goal.yaws.size(); ++i) turn += yaw_distance(o.goal.yaws[i - 1], o.goal.yaws[i]);
-    turn += yaw_distance(ctx.pose.yaw, o.goal.yaws.front());
+    for (size_t i = 1; i < o.goal.yaws.size(); ++i) turn += core::yaw_distance(o.goal.yaws[i - 1], o.goal.yaws[i]);
+    turn += core::yaw_distance(ctx.pose.yaw, o.goal.yaws.front());
     // The cost is the travel time of the turn flown (charged the direct turn, the goals through
     // the doorway of this room scored above those that do not turn back and won).
     const double distance = o.goal.waypoints.size() > 1 ? [&] {
@@ -521,8 +521,8 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
     EXPECT_NEAR(o.goal.cost, travel_time(distance, turn, f.config.cost), 1e-6) << cycle;
     // Goals whose path turns more than the direct turn (a held heading), some of them from the
     // vehicle's own waypoint (the turn 72da60a added): what this test is about.
-    held += turn > yaw_distance(ctx.pose.yaw, o.goal.yaw) + 0.5;
-    held_at_vehicle += yaw_distance(ctx.pose.yaw, o.goal.yaws.front()) > 0.5;
+    held += turn > core::yaw_distance(ctx.pose.yaw, o.goal.yaw) + 0.5;
+    held_at_vehicle += core::yaw_distance(ctx.pose.yaw, o.goal.yaws.front()) > 0.5;
   }
   EXPECT_GT(goals, 0);
   EXPECT_GT(held, 0);

@@ -6,7 +6,7 @@
 #include <tuple>
 
 #include "semx/simulator/ground_truth.hpp"
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/ray_caster.hpp"
 #include "semx/simulator/sensor_noise.hpp"
@@ -234,7 +234,7 @@ TEST(Render, ChannelsAndImageSizesGiveTheSamePixels) {
     o.rgb_far = rgb_far;
     Rasterizer r(w, o);
     RayCaster rc(w);
-    Rng rng(11);
+    core::XoshiroRng rng(11);
     for (const auto& [width, height] : {std::pair{640, 480}, {333, 77}, {7, 5}}) {
       PinholeCamera cam;
       cam.width = width;
@@ -283,7 +283,7 @@ TEST(Render, RasterizerAgreesWithRayCasterOnShippedWorlds) {
     const VehicleReachability reach(gt, w.start.position);
     Rasterizer r(w);
     RayCaster rc(w);
-    Rng rng(5);
+    core::XoshiroRng rng(5);
     int frames = 0;
     CameraFrame a, b;
     while (frames < 4) {

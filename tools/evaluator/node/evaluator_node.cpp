@@ -22,11 +22,6 @@ namespace semx::evaluator {
 
 namespace ch = semx::channels;
 
-static_assert(semx::planner_status_t::DONE == static_cast<int>(PlannerState::kDone) &&
-                  semx::planner_status_t::FAILED == static_cast<int>(PlannerState::kFailed) &&
-                  semx::planner_status_t::INIT == static_cast<int>(PlannerState::kInit),
-              "PlannerState mirrors planner_status_t");
-
 namespace {
 
 double wall_now() {

@@ -4,30 +4,6 @@
 
 namespace semx::evaluator {
 
-const char* to_string(PlannerState s) {
-  switch (s) {
-    case PlannerState::kUnknown:
-      return "none";
-    case PlannerState::kInit:
-      return "INIT";
-    case PlannerState::kPlanning:
-      return "PLANNING";
-    case PlannerState::kExecuting:
-      return "EXECUTING";
-    case PlannerState::kRecovering:
-      return "RECOVERING";
-    case PlannerState::kDone:
-      return "DONE";
-    case PlannerState::kFailed:
-      return "FAILED";
-  }
-  return "none";
-}
-
-PlannerState planner_state_from_int(int v) {
-  return v >= 0 && v <= 5 ? static_cast<PlannerState>(v) : PlannerState::kUnknown;
-}
-
 const char* to_string(Termination t) {
   switch (t) {
     case Termination::kRunning:

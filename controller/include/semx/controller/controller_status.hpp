@@ -4,18 +4,11 @@
 #include <cstdint>
 #include <string>
 
+#include "semx/core/states.hpp"
+
 namespace semx::controller {
 
-// Values match controller_status_t's constants.
-enum class ControllerState : int8_t {
-  kIdle = 0,        // nothing to fly (start-up, or inputs fresh again after a stop): hover
-  kTracking = 1,    // flying a trajectory
-  kBraking = 2,     // a new ESDF predicted a collision: trajectory dropped, hover, replan
-  kHolding = 3,     // the trajectory ended: holding its end point
-  kStaleInput = 4,  // odometry or ESDF too old (or missing): trajectory dropped, hover
-  kRejected = 5     // the last path was bad or had no safe trajectory: hover, replan
-};
-const char* to_string(ControllerState s);
+using core::ControllerState;  // the message contract's values and names (semx/core/states.hpp)
 
 struct ControllerStatus {
   int64_t plan_id = -1;  // the path the state refers to; -1 before the first

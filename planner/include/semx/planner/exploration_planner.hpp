@@ -37,7 +37,7 @@
 #include "semx/planner/gain_evaluator.hpp"
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/planner/rng.hpp"
+#include "semx/core/random.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/strategy.hpp"
 #include "semx/planner/voxel_set.hpp"
@@ -127,7 +127,7 @@ class ExplorationPlanner {
   VoxelSet unobservable_;
   int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
   int64_t short_since_ = -1;    // since when the controller holds away from the goal
-  Rng rng_;
+  core::SplitMixRng rng_;
   const mapper::StateGrid* grid_ = nullptr;
   std::optional<VehiclePose> pose_;
   std::vector<SemanticRegion> regions_;

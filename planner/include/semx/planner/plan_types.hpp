@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "semx/core/states.hpp"
+
 namespace semx::planner {
 
 struct VehiclePose {
@@ -22,26 +24,9 @@ struct PlannedPath {
   std::vector<double> yaws;                // heading at each waypoint, rad
 };
 
-// Values of planner_status_t.state.
-enum class PlannerState : int8_t {
-  kInit = 0,
-  kPlanning = 1,
-  kExecuting = 2,
-  kRecovering = 3,
-  kDone = 4,
-  kFailed = 5,
-};
-const char* to_string(PlannerState s);
-
-// Controller states the planner reacts to (values of controller_status_t.state).
-enum class ControllerState : int8_t {
-  kIdle = 0,
-  kTracking = 1,
-  kBraking = 2,
-  kHolding = 3,
-  kStaleInput = 4,
-  kRejected = 5,
-};
+// The status values of the message contract (semx/core/states.hpp).
+using core::ControllerState;
+using core::PlannerState;
 
 // Work done by one planning cycle: what the planning-time charge is computed from, and the wall
 // time of each part (reported, never used for decisions).

@@ -11,7 +11,7 @@
 
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/planner/rng.hpp"
+#include "semx/core/random.hpp"
 
 namespace semx::planner {
 
@@ -20,7 +20,7 @@ class Sampler {
   explicit Sampler(const SamplingConfig& config) : config_(config) {}
 
   // One draw. `frontier_fraction` overrides the configured share (recovery uses 1).
-  Eigen::Vector3d draw(Rng& rng, const Eigen::Vector3d& vehicle,
+  Eigen::Vector3d draw(core::SplitMixRng& rng, const Eigen::Vector3d& vehicle,
                        const std::vector<FrontierTracker::Cluster>& clusters, double frontier_fraction,
                        bool* around_frontier = nullptr) const {
     const bool frontier = !clusters.empty() && rng.uniform() < frontier_fraction;

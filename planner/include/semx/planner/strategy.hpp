@@ -15,7 +15,7 @@
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/planner/rng.hpp"
+#include "semx/core/random.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/voxel_set.hpp"
 
@@ -30,7 +30,7 @@ struct PlanContext {
   const VoxelSet* unobservable = nullptr;
   int64_t cycle = 0;
   bool recovering = false;  // the previous cycles found no goal: sample for frontiers
-  Rng* rng = nullptr;
+  core::SplitMixRng* rng = nullptr;
   CycleCounters* counters = nullptr;
 };
 

@@ -10,7 +10,7 @@
 
 #include <algorithm>
 
-#include "semx/planner/angles.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/planner/planner_config.hpp"
 
 namespace semx::planner {
@@ -23,7 +23,7 @@ inline double travel_time(double distance, double yaw_change, const CostConfig& 
 }
 
 inline double travel_time(double distance, double from_yaw, double to_yaw, const CostConfig& c) {
-  return travel_time(distance, yaw_distance(from_yaw, to_yaw), c);
+  return travel_time(distance, core::yaw_distance(from_yaw, to_yaw), c);
 }
 
 inline double node_score(double gain, double reward, double time) { return (gain + reward) / time; }

@@ -7,7 +7,7 @@
 
 #include "semx/runtime/config.hpp"
 #include "semx/simulator/quadrotor.hpp"
-#include "semx/simulator/random.hpp"
+#include "semx/core/random.hpp"
 
 namespace semx::simulator {
 
@@ -35,7 +35,7 @@ class ImuModel {
 
  private:
   ImuConfig config_;
-  Rng rng_;
+  core::XoshiroRng rng_;
   Eigen::Vector3d accel_bias_ = Eigen::Vector3d::Zero(), gyro_bias_ = Eigen::Vector3d::Zero();
 };
 

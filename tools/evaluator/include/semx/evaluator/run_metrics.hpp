@@ -24,20 +24,13 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/states.hpp"
+
 namespace semx::evaluator {
 
-// Mirrors planner_status_t's state constants (checked against them where the message is known).
-enum class PlannerState : int8_t {
-  kUnknown = -1,  // no PLANNER_STATUS heard yet
-  kInit = 0,
-  kPlanning = 1,
-  kExecuting = 2,
-  kRecovering = 3,
-  kDone = 4,
-  kFailed = 5,
-};
-const char* to_string(PlannerState s);
-PlannerState planner_state_from_int(int v);  // kUnknown for anything else
+// The message contract's planner states (kUnknown: no PLANNER_STATUS heard yet).
+using core::PlannerState;
+using core::planner_state_from_int;
 
 // Why a run ended.
 enum class Termination {

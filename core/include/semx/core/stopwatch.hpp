@@ -1,13 +1,13 @@
-// Timing of the cycle's parts, for PLANNER_STATUS and the benchmark only (decisions use message
-// time): wall time, and the calling thread's CPU time (what the cycle costs on one core whatever
-// else the machine is doing).
+// Wall and thread-CPU time of a piece of work, for status messages and benchmarks only:
+// decisions use message time (DESIGN.md §3). CPU time is what the work costs on one core
+// whatever else the machine is doing.
 #pragma once
 
 #include <time.h>
 
 #include <chrono>
 
-namespace semx::planner {
+namespace semx::core {
 
 inline double thread_cpu_ms() {
   timespec ts{};
@@ -21,6 +21,7 @@ class Stopwatch {
   double ms() const {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
   }
+  double s() const { return 1e-3 * ms(); }
   double cpu_ms() const { return thread_cpu_ms() - cpu_start_; }
 
  private:
@@ -28,4 +29,4 @@ class Stopwatch {
   double cpu_start_;
 };
 
-}  // namespace semx::planner
+}  // namespace semx::core
