@@ -15,24 +15,12 @@
 #include <vector>
 
 #include "semx/mapper/mapper.hpp"
+#include "semx/runtime/log_scan.hpp"
 
 namespace semx::mapper {
 
-class ReplayError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// The layout of an LCM log file, from its event headers alone.
-struct LogLayout {
-  int64_t events = 0;  // complete events
-  uint64_t file_bytes = 0;
-  bool truncated = false;     // the file ends inside an event
-  uint64_t truncated_at = 0;  // byte offset of that event
-};
-// Throws ReplayError naming the file: missing or unreadable, empty, not an LCM log, or a corrupt
-// event header (with its byte offset and event number).
-LogLayout scan_log(const std::string& path);
+// What replay_log throws: the log's scan errors (runtime::scan_log) and its own.
+using ReplayError = runtime::LogError;
 
 struct ReplayOptions {
   std::string log_path;
@@ -40,7 +28,7 @@ struct ReplayOptions {
 };
 
 struct ReplayReport {
-  LogLayout layout;
+  runtime::LogLayout layout;
   std::map<std::string, int64_t> channels;  // events per channel
   int64_t depth_events = 0;
   int64_t integrated = 0;

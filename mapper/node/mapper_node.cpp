@@ -68,7 +68,7 @@ MapperNode::MapperNode(runtime::Node& node, const MapperConfig& config, MapperNo
   node_.subscribe<semx::odometry_t>(
       ch::ODOMETRY, [this](const semx::odometry_t& m) { on_odometry(m); }, &accept_odometry);
   node_.subscribe<semx::map_request_t>(
-      ch::MAP_REQUEST, [this](const semx::map_request_t& m) { on_request(m); }, &accept_request);
+      ch::MAP_REQUEST, [this](const semx::map_request_t& m) { on_request(m); }, &map::accept_request);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
   node_.on_quiet_until([this](int64_t utime) { return quiet_until(utime); });
 }
@@ -165,7 +165,7 @@ void MapperNode::on_depth(const semx::depth_image_t& m) {
 void MapperNode::compute(Job& job) {
   job.result = mapper_.integrate(job.frame.frame());
   if (!job.result.report.accepted) return;
-  job.update_bytes = encode(to_message(job.result.delta));
+  job.update_bytes = encode(map::to_message(job.result.delta));
   const MapperConfig& cfg = mapper_.config();
   if (cfg.esdf.enabled &&
       (cfg.streaming.esdf_period <= 0 || due(job.now, next_esdf_, cfg.streaming.esdf_period))) {
@@ -174,7 +174,7 @@ void MapperNode::compute(Job& job) {
       job.esdf_recomputed = true;
       job.esdf_ms = mapper_.esdf_ms();
     }
-    job.esdf_bytes = encode(to_message(mapper_.esdf(), job.frame.utime));
+    job.esdf_bytes = encode(map::to_message(mapper_.esdf(), job.frame.utime));
   }
 }
 
@@ -324,16 +324,16 @@ void MapperNode::poll_wall() {
 
 void MapperNode::publish_snapshot() {
   flush_frames();  // the worker owns the map while frames are in flight
-  node_.publish(ch::MAP_SNAPSHOT, to_message(mapper_.snapshot(now_)));
+  node_.publish(ch::MAP_SNAPSHOT, map::to_message(mapper_.snapshot(now_)));
   ++counters_.snapshots;
   request_pending_ = false;
 }
 
 void MapperNode::publish_stats() {
   flush_frames();
-  MapStats s = mapper_.stats(true);
+  map::MapStats s = mapper_.stats(true);
   s.frames_rejected += frames_malformed();
-  node_.publish(ch::MAP_STATS, to_message(s, now_));
+  node_.publish(ch::MAP_STATS, map::to_message(s, now_));
   ++counters_.stats;
   update_state();
 }

@@ -41,7 +41,8 @@
 #include <string>
 #include <thread>
 
-#include "messages.hpp"
+#include "map_messages.hpp"
+#include "mapper_messages.hpp"
 #include "semx/mapper/mapper.hpp"
 #include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/node.hpp"

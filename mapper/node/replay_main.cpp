@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
                 << " frames could be integrated; nothing written\n";
       return 1;
     }
-    const mapper::MapStats s = m.stats(true);
+    const map::MapStats s = m.stats(true);
     std::printf(
         "semx-map-replay: map seq %lld: %lld free + %lld occupied voxels (%.2f m3 known), %lld frontier "
         "voxels, bounds [%.2f %.2f %.2f] .. [%.2f %.2f %.2f] m\n",

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <limits>
 
-#include "byte_io.hpp"
+#include "semx/map/byte_io.hpp"
 
 namespace semx::mapper {
 
@@ -16,7 +16,7 @@ namespace {
 constexpr char kMagic[8] = {'S', 'E', 'M', 'X', 'M', 'A', 'P', '\0'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderSize = 96;
-constexpr size_t kBlockRecord = 12 + kBlockVolume * sizeof(float);
+constexpr size_t kBlockRecord = 12 + map::kBlockVolume * sizeof(float);
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw MapIoError("map checkpoint '" + path + "': " + what);
@@ -36,7 +36,7 @@ Header parse_header(const std::string& path, const std::vector<uint8_t>& file) {
                    std::to_string(kHeaderSize) + "-byte header");
   }
   if (std::memcmp(file.data(), kMagic, 8) != 0) fail(path, "not a semx map checkpoint (bad magic)");
-  detail::ByteReader r(file.data() + 8, kHeaderSize - 8);
+  map::detail::ByteReader r(file.data() + 8, kHeaderSize - 8);
   Header h;
   h.info.version = r.u32();
   if (h.info.version != kVersion) {
@@ -54,7 +54,7 @@ Header parse_header(const std::string& path, const std::vector<uint8_t>& file) {
   h.compressed_size = r.u64();
   h.payload_crc = r.u32();
   const uint32_t header_crc = r.u32();
-  if (header_crc != detail::crc32_of(file.data(), kHeaderSize - 4))
+  if (header_crc != map::detail::crc32_of(file.data(), kHeaderSize - 4))
     fail(path, "header checksum mismatch (corrupt file)");
   if (header_size != kHeaderSize) fail(path, "unexpected header size " + std::to_string(header_size));
   h.info.file_bytes = file.size();
@@ -77,17 +77,17 @@ std::vector<uint8_t> read_file(const std::string& path, size_t limit) {
 }  // namespace
 
 CheckpointInfo save_checkpoint(const OccupancyMap& map, int64_t seq, int64_t utime, const std::string& path) {
-  const StateGrid& grid = map.grid();
+  const map::StateGrid& grid = map.grid();
   std::vector<uint8_t> raw;
-  detail::ByteWriter w(raw);
+  map::detail::ByteWriter w(raw);
   uint64_t blocks = 0;
-  float values[kBlockVolume];
-  for (const VoxelKey& bk : grid.sorted_block_keys()) {
-    const VoxelBlock* b = grid.find_block(bk);
+  float values[map::kBlockVolume];
+  for (const map::VoxelKey& bk : grid.sorted_block_keys()) {
+    const map::VoxelBlock* b = grid.find_block(bk);
     if (b->known == 0) continue;
-    for (int i = 0; i < kBlockVolume; ++i) {
+    for (int i = 0; i < map::kBlockVolume; ++i) {
       values[i] =
-          b->state[i] == VoxelState::kUnknown ? std::numeric_limits<float>::quiet_NaN() : b->log_odds[i];
+          b->state[i] == map::VoxelState::kUnknown ? std::numeric_limits<float>::quiet_NaN() : b->log_odds[i];
     }
     w.i32(bk.x);
     w.i32(bk.y);
@@ -95,10 +95,10 @@ CheckpointInfo save_checkpoint(const OccupancyMap& map, int64_t seq, int64_t uti
     for (float v : values) w.f32(v);
     ++blocks;
   }
-  const std::vector<uint8_t> payload = detail::zlib_compress(raw, 1);
+  const std::vector<uint8_t> payload = map::detail::zlib_compress(raw, 1);
 
   std::vector<uint8_t> header;
-  detail::ByteWriter h(header);
+  map::detail::ByteWriter h(header);
   h.bytes(kMagic, 8);
   h.u32(kVersion);
   h.u32(kHeaderSize);
@@ -114,8 +114,8 @@ CheckpointInfo save_checkpoint(const OccupancyMap& map, int64_t seq, int64_t uti
   h.u64(blocks);
   h.u64(raw.size());
   h.u64(payload.size());
-  h.u32(detail::crc32_of(payload.data(), payload.size()));
-  h.u32(detail::crc32_of(header.data(), header.size()));
+  h.u32(map::detail::crc32_of(payload.data(), payload.size()));
+  h.u32(map::detail::crc32_of(header.data(), header.size()));
 
   const std::string tmp = path + ".tmp";
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
@@ -158,7 +158,7 @@ CheckpointInfo load_checkpoint(const std::string& path, OccupancyMap& map) {
     fail(path, std::to_string(file.size() - expected) + " unexpected bytes after the payload");
   }
   const uint8_t* payload = file.data() + kHeaderSize;
-  if (detail::crc32_of(payload, h.compressed_size) != h.payload_crc) {
+  if (map::detail::crc32_of(payload, h.compressed_size) != h.payload_crc) {
     fail(path, "payload checksum mismatch (corrupt file)");
   }
   if (h.info.blocks > (uint64_t{1} << 24) || h.raw_size != h.info.blocks * kBlockRecord) {
@@ -170,15 +170,15 @@ CheckpointInfo load_checkpoint(const std::string& path, OccupancyMap& map) {
                    std::to_string(map.resolution()) + " m");
   }
   std::vector<uint8_t> raw;
-  if (!detail::zlib_decompress(payload, h.compressed_size, h.raw_size, raw))
+  if (!map::detail::zlib_decompress(payload, h.compressed_size, h.raw_size, raw))
     fail(path, "corrupt compressed payload");
 
   OccupancyMap fresh(map.params());
-  detail::ByteReader r(raw.data(), raw.size());
-  constexpr int32_t kMaxBlock = kMaxKeyMagnitude >> kBlockBits;
-  float values[kBlockVolume];
+  map::detail::ByteReader r(raw.data(), raw.size());
+  constexpr int32_t kMaxBlock = map::kMaxKeyMagnitude >> map::kBlockBits;
+  float values[map::kBlockVolume];
   for (uint64_t n = 0; n < h.info.blocks; ++n) {
-    const VoxelKey bk{r.i32(), r.i32(), r.i32()};
+    const map::VoxelKey bk{r.i32(), r.i32(), r.i32()};
     if (std::abs(bk.x) >= kMaxBlock || std::abs(bk.y) >= kMaxBlock || std::abs(bk.z) >= kMaxBlock) {
       fail(path, "block key out of range");
     }

@@ -222,7 +222,7 @@ std::string check_frame(const DepthFrame& f) {
 DepthIntegrator::DepthIntegrator(const IntegrationParams& params) : params_(params) {}
 
 IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& map,
-                                             std::vector<VoxelChange>* changes) {
+                                             std::vector<map::VoxelChange>* changes) {
   IntegrationReport rep;
   rep.error = check_frame(f);
   if (!rep.error.empty()) return rep;
@@ -256,7 +256,7 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
   }
   rep.accepted = true;
   // Two voxels of margin: a walk can overshoot its segment's box by one voxel on rounding.
-  const VoxelKey origin{static_cast<int32_t>(std::floor(lo.x())) - 2,
+  const map::VoxelKey origin{static_cast<int32_t>(std::floor(lo.x())) - 2,
                         static_cast<int32_t>(std::floor(lo.y())) - 2,
                         static_cast<int32_t>(std::floor(lo.z())) - 2};
   const int nx = static_cast<int>(std::floor(hi.x())) + 3 - origin.x;
@@ -345,11 +345,11 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
 
   // ---- pass 2: one observation per observed voxel, in memory order (consecutive voxels share
   // blocks), clearing the scratch as it goes ----
-  const VoxelKey bmin = block_of(origin);
-  const VoxelKey bmax = block_of(origin + VoxelKey{nx - 1, ny - 1, nz - 1});
+  const map::VoxelKey bmin = map::block_of(origin);
+  const map::VoxelKey bmax = map::block_of(origin + map::VoxelKey{nx - 1, ny - 1, nz - 1});
   const int bnx = bmax.x - bmin.x + 1, bny = bmax.y - bmin.y + 1, bnz = bmax.z - bmin.z + 1;
   block_table_.assign(static_cast<size_t>(bnx) * bny * bnz, nullptr);
-  const std::optional<KeyBox> bounds = map.bounds();
+  const std::optional<map::KeyBox> bounds = map.bounds();
   const uint32_t mask_x = (1u << sx) - 1, mask_y = (1u << sy) - 1;
   for (size_t w = 0; w < words; ++w) {
     uint64_t bytes;
@@ -362,7 +362,7 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
       bytes &= ~(uint64_t{0xFF} << (8 * b));
       if (!(m & kWalked)) continue;  // a max-range end voxel nothing else passed through
       const uint32_t idx = static_cast<uint32_t>(w * 8 + b);
-      const VoxelKey key{origin.x + static_cast<int32_t>(idx & mask_x),
+      const map::VoxelKey key{origin.x + static_cast<int32_t>(idx & mask_x),
                          origin.y + static_cast<int32_t>((idx >> sx) & mask_y),
                          origin.z + static_cast<int32_t>(idx >> sxy)};
       ++rep.voxels_updated;
@@ -370,12 +370,12 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
         ++rep.out_of_bounds;
         continue;
       }
-      const VoxelKey bk = block_of(key);
-      VoxelBlock*& block =
+      const map::VoxelKey bk = map::block_of(key);
+      map::VoxelBlock*& block =
           block_table_[(static_cast<size_t>(bk.z - bmin.z) * bny + (bk.y - bmin.y)) * bnx + (bk.x - bmin.x)];
       if (!block) block = &map.block(bk);
-      VoxelState before, after;
-      map.apply(*block, key, local_index(key), (m & kHit) != 0, before, after);
+      map::VoxelState before, after;
+      map.apply(*block, key, map::local_index(key), (m & kHit) != 0, before, after);
       if (before != after) {
         ++rep.voxels_changed;
         rep.changed_bounds.include(key);

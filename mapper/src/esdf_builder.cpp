@@ -118,20 +118,20 @@ EsdfBuilder::EsdfBuilder(const EsdfParams& params, double resolution) : params_(
   }
 }
 
-VoxelKey EsdfBuilder::window_origin(const Eigen::Vector3d& center) const {
-  const KeyMath km(grid_.resolution);
-  const VoxelKey c = km.key(center);
+map::VoxelKey EsdfBuilder::window_origin(const Eigen::Vector3d& center) const {
+  const map::KeyMath km(grid_.resolution);
+  const map::VoxelKey c = km.key(center);
   return {c.x - grid_.nx / 2, c.y - grid_.ny / 2, c.z - grid_.nz / 2};
 }
 
-bool EsdfBuilder::update(const StateGrid& grid, const Eigen::Vector3d& center, const KeyBox& changed,
+bool EsdfBuilder::update(const map::StateGrid& grid, const Eigen::Vector3d& center, const map::KeyBox& changed,
                          int64_t map_seq, bool force) {
-  VoxelKey probe;
-  if (!KeyMath(grid_.resolution).key(center, probe)) return false;
-  const VoxelKey origin = window_origin(center);
-  KeyBox window;
+  map::VoxelKey probe;
+  if (!map::KeyMath(grid_.resolution).key(center, probe)) return false;
+  const map::VoxelKey origin = window_origin(center);
+  map::KeyBox window;
   window.min = origin;
-  window.max = origin + VoxelKey{grid_.nx - 1, grid_.ny - 1, grid_.nz - 1};
+  window.max = origin + map::VoxelKey{grid_.nx - 1, grid_.ny - 1, grid_.nz - 1};
   const bool recompute = force || grid_.empty() || origin != grid_.origin || changed.intersects(window);
   grid_.map_seq = map_seq;
   if (!recompute) return false;
@@ -140,7 +140,7 @@ bool EsdfBuilder::update(const StateGrid& grid, const Eigen::Vector3d& center, c
   return true;
 }
 
-void EsdfBuilder::compute(const StateGrid& grid) {
+void EsdfBuilder::compute(const map::StateGrid& grid) {
   const int nx = grid_.nx, ny = grid_.ny, nz = grid_.nz;
   const size_t n = static_cast<size_t>(nx) * ny * nz;
   obstacle_.resize(n);
@@ -150,17 +150,17 @@ void EsdfBuilder::compute(const StateGrid& grid) {
   const uint8_t unknown_value = params_.unknown_as_occupied ? 1 : 0;
 
   // Block by block: one hash lookup per block of the window.
-  const VoxelKey o = grid_.origin;
-  const VoxelKey last = o + VoxelKey{nx - 1, ny - 1, nz - 1};
-  const VoxelKey bmin = block_of(o), bmax = block_of(last);
+  const map::VoxelKey o = grid_.origin;
+  const map::VoxelKey last = o + map::VoxelKey{nx - 1, ny - 1, nz - 1};
+  const map::VoxelKey bmin = map::block_of(o), bmax = map::block_of(last);
   for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
     for (int32_t by = bmin.y; by <= bmax.y; ++by) {
       for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const VoxelBlock* b = grid.find_block({bx, by, bz});
-        const VoxelKey base{bx * kBlockSize, by * kBlockSize, bz * kBlockSize};
-        const int x0 = std::max(o.x, base.x), x1 = std::min(last.x, base.x + kBlockMask);
-        const int y0 = std::max(o.y, base.y), y1 = std::min(last.y, base.y + kBlockMask);
-        const int z0 = std::max(o.z, base.z), z1 = std::min(last.z, base.z + kBlockMask);
+        const map::VoxelBlock* b = grid.find_block({bx, by, bz});
+        const map::VoxelKey base{bx * map::kBlockSize, by * map::kBlockSize, bz * map::kBlockSize};
+        const int x0 = std::max(o.x, base.x), x1 = std::min(last.x, base.x + map::kBlockMask);
+        const int y0 = std::max(o.y, base.y), y1 = std::min(last.y, base.y + map::kBlockMask);
+        const int z0 = std::max(o.z, base.z), z1 = std::min(last.z, base.z + map::kBlockMask);
         for (int z = z0; z <= z1; ++z) {
           for (int y = y0; y <= y1; ++y) {
             uint8_t* dst = &obstacle_[grid_.index(x0 - o.x, y - o.y, z - o.z)];
@@ -168,11 +168,11 @@ void EsdfBuilder::compute(const StateGrid& grid) {
               std::memset(dst, unknown_value, x1 - x0 + 1);
               continue;
             }
-            const VoxelState* row =
-                &b->state[((y - base.y) << kBlockBits) | ((z - base.z) << (2 * kBlockBits))];
+            const map::VoxelState* row =
+                &b->state[((y - base.y) << map::kBlockBits) | ((z - base.z) << (2 * map::kBlockBits))];
             for (int x = x0; x <= x1; ++x) {
-              const VoxelState s = row[x - base.x];
-              dst[x - x0] = s == VoxelState::kOccupied ? 1 : (s == VoxelState::kUnknown ? unknown_value : 0);
+              const map::VoxelState s = row[x - base.x];
+              dst[x - x0] = s == map::VoxelState::kOccupied ? 1 : (s == map::VoxelState::kUnknown ? unknown_value : 0);
             }
           }
         }

@@ -24,12 +24,12 @@ std::unique_ptr<octomap::OcTree> to_octree(const OccupancyMap& map, ExportReport
   tree->setClampingThresMax(p.clamp_max);
   tree->setOccupancyThres(p.threshold);
   ExportReport rep;
-  for (const VoxelKey& bk : map.grid().sorted_block_keys()) {
-    const VoxelBlock* b = map.grid().find_block(bk);
+  for (const map::VoxelKey& bk : map.grid().sorted_block_keys()) {
+    const map::VoxelBlock* b = map.grid().find_block(bk);
     if (b->known == 0) continue;
-    for (int i = 0; i < kBlockVolume; ++i) {
-      if (b->state[i] == VoxelState::kUnknown) continue;
-      const VoxelKey k = voxel_of(bk, i);
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (b->state[i] == map::VoxelState::kUnknown) continue;
+      const map::VoxelKey k = map::voxel_of(bk, i);
       if (k.x < -kOctoOffset || k.x >= kOctoOffset || k.y < -kOctoOffset || k.y >= kOctoOffset ||
           k.z < -kOctoOffset || k.z >= kOctoOffset) {
         ++rep.skipped;
@@ -54,13 +54,13 @@ ExportReport export_octomap_bt(const OccupancyMap& map, const std::string& path)
   return rep;
 }
 
-ExportReport export_occupied_pcd(const StateGrid& grid, const std::string& path, bool binary) {
+ExportReport export_occupied_pcd(const map::StateGrid& grid, const std::string& path, bool binary) {
   std::vector<float> xyz;
-  for (const VoxelKey& bk : grid.sorted_block_keys()) {
-    const VoxelBlock* b = grid.find_block(bk);
-    for (int i = 0; i < kBlockVolume; ++i) {
-      if (b->state[i] != VoxelState::kOccupied) continue;
-      const Eigen::Vector3d c = grid.keys().center(voxel_of(bk, i));
+  for (const map::VoxelKey& bk : grid.sorted_block_keys()) {
+    const map::VoxelBlock* b = grid.find_block(bk);
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (b->state[i] != map::VoxelState::kOccupied) continue;
+      const Eigen::Vector3d c = grid.keys().center(map::voxel_of(bk, i));
       xyz.insert(xyz.end(),
                  {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())});
     }

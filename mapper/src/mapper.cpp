@@ -54,14 +54,14 @@ bool Mapper::update_esdf(const Eigen::Vector3d& center, bool force) {
   const bool recomputed = esdf_.update(map_.grid(), center, esdf_dirty_, seq_, force || esdf_stale_);
   if (recomputed) {
     esdf_ms_ = ms_since(t0);
-    esdf_dirty_ = KeyBox();
+    esdf_dirty_ = map::KeyBox();
     esdf_stale_ = false;
   }
   return recomputed;
 }
 
-MapStats Mapper::stats(bool count_frontiers) const {
-  MapStats s = compute_stats(map_.grid(), seq_, count_frontiers);
+map::MapStats Mapper::stats(bool count_frontiers) const {
+  map::MapStats s = map::compute_stats(map_.grid(), seq_, count_frontiers);
   s.frames_integrated = frames_integrated_;
   s.frames_rejected = frames_rejected_;
   s.integrate_ms = last_integrate_ms_;

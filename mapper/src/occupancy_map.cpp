@@ -30,46 +30,46 @@ OccupancyMap::OccupancyMap(const OccupancyParams& params)
   }
 }
 
-std::optional<float> OccupancyMap::log_odds(const VoxelKey& k) const {
-  const VoxelBlock* b = grid_.find_block(block_of(k));
+std::optional<float> OccupancyMap::log_odds(const map::VoxelKey& k) const {
+  const map::VoxelBlock* b = grid_.find_block(map::block_of(k));
   if (!b) return std::nullopt;
-  const int i = local_index(k);
-  if (b->state[i] == VoxelState::kUnknown) return std::nullopt;
+  const int i = map::local_index(k);
+  if (b->state[i] == map::VoxelState::kUnknown) return std::nullopt;
   return b->log_odds[i];
 }
 
-VoxelState OccupancyMap::update(const VoxelKey& k, bool hit, bool* changed) {
+map::VoxelState OccupancyMap::update(const map::VoxelKey& k, bool hit, bool* changed) {
   if (!in_bounds(k)) {
     if (changed) *changed = false;
     return grid_.state(k);
   }
-  VoxelBlock& b = grid_.get_or_create_block(block_of(k));
-  VoxelState before, after;
-  apply(b, k, local_index(k), hit, before, after);
+  map::VoxelBlock& b = grid_.get_or_create_block(map::block_of(k));
+  map::VoxelState before, after;
+  apply(b, k, map::local_index(k), hit, before, after);
   if (changed) *changed = before != after;
   return after;
 }
 
-void OccupancyMap::set_log_odds(const VoxelKey& k, float log_odds) {
+void OccupancyMap::set_log_odds(const map::VoxelKey& k, float log_odds) {
   if (std::isnan(log_odds)) {
-    grid_.set_state(k, VoxelState::kUnknown);
+    grid_.set_state(k, map::VoxelState::kUnknown);
     return;
   }
-  VoxelBlock& b = grid_.get_or_create_block(block_of(k));
-  const int i = local_index(k);
+  map::VoxelBlock& b = grid_.get_or_create_block(map::block_of(k));
+  const int i = map::local_index(k);
   const float l = std::min(std::max(log_odds, l_min_), l_max_);
   b.log_odds[i] = l;
-  const VoxelState before = b.state[i];
-  const VoxelState after = classify(l);
+  const map::VoxelState before = b.state[i];
+  const map::VoxelState after = classify(l);
   b.state[i] = after;
   grid_.note_transition(b, k, before, after);
 }
 
-void OccupancyMap::set_block_log_odds(const VoxelKey& block_key, const float* values) {
-  VoxelBlock& b = grid_.get_or_create_block(block_key);
-  for (int i = 0; i < kBlockVolume; ++i) {
-    const VoxelState before = b.state[i];
-    VoxelState after = VoxelState::kUnknown;
+void OccupancyMap::set_block_log_odds(const map::VoxelKey& block_key, const float* values) {
+  map::VoxelBlock& b = grid_.get_or_create_block(block_key);
+  for (int i = 0; i < map::kBlockVolume; ++i) {
+    const map::VoxelState before = b.state[i];
+    map::VoxelState after = map::VoxelState::kUnknown;
     float l = 0.0f;
     if (!std::isnan(values[i])) {
       l = std::min(std::max(values[i], l_min_), l_max_);
@@ -77,7 +77,7 @@ void OccupancyMap::set_block_log_odds(const VoxelKey& block_key, const float* va
     }
     b.log_odds[i] = l;
     b.state[i] = after;
-    grid_.note_transition(b, voxel_of(block_key, i), before, after);
+    grid_.note_transition(b, map::voxel_of(block_key, i), before, after);
   }
 }
 

@@ -17,7 +17,7 @@
 
 #include "semx/mapper/map_export.hpp"
 #include "semx/mapper/mapper.hpp"
-#include "semx/mapper/synthetic_room.hpp"
+#include "semx/fixtures/synthetic_room.hpp"
 
 namespace sm = semx::mapper;
 using Clock = std::chrono::steady_clock;
@@ -62,19 +62,19 @@ struct Agreement {
   double percent() const { return 100.0 * agree / std::max<int64_t>(1, union_n); }
 };
 
-Agreement compare(const sm::StateGrid& grid, const octomap::OcTree& tree) {
+Agreement compare(const semx::map::StateGrid& grid, const octomap::OcTree& tree) {
   constexpr int32_t kOff = 32768;  // OctoMap key = semx key + 32768
   Agreement a;
-  for (const sm::VoxelKey& bk : grid.sorted_block_keys()) {
-    const sm::VoxelBlock* b = grid.find_block(bk);
-    for (int i = 0; i < sm::kBlockVolume; ++i) {
-      const sm::VoxelState s = b->state[i];
-      if (s == sm::VoxelState::kUnknown) continue;
-      const sm::VoxelKey k = sm::voxel_of(bk, i);
+  for (const semx::map::VoxelKey& bk : grid.sorted_block_keys()) {
+    const semx::map::VoxelBlock* b = grid.find_block(bk);
+    for (int i = 0; i < semx::map::kBlockVolume; ++i) {
+      const semx::map::VoxelState s = b->state[i];
+      if (s == semx::map::VoxelState::kUnknown) continue;
+      const semx::map::VoxelKey k = semx::map::voxel_of(bk, i);
       const octomap::OcTreeNode* n = tree.search(octomap::OcTreeKey(k.x + kOff, k.y + kOff, k.z + kOff));
       if (!n) {
         ++a.only_ours;
-      } else if ((tree.isNodeOccupied(n) ? sm::VoxelState::kOccupied : sm::VoxelState::kFree) == s) {
+      } else if ((tree.isNodeOccupied(n) ? semx::map::VoxelState::kOccupied : semx::map::VoxelState::kFree) == s) {
         ++a.agree;
       } else {
         ++a.free_vs_occupied;
@@ -88,8 +88,8 @@ Agreement compare(const sm::StateGrid& grid, const octomap::OcTree& tree) {
     for (int dz = 0; dz < span; ++dz) {
       for (int dy = 0; dy < span; ++dy) {
         for (int dx = 0; dx < span; ++dx) {
-          const sm::VoxelKey k{base[0] + dx - kOff, base[1] + dy - kOff, base[2] + dz - kOff};
-          if (grid.state(k) == sm::VoxelState::kUnknown) ++a.only_octomap;
+          const semx::map::VoxelKey k{base[0] + dx - kOff, base[1] + dy - kOff, base[2] + dz - kOff};
+          if (grid.state(k) == semx::map::VoxelState::kUnknown) ++a.only_octomap;
         }
       }
     }
@@ -242,7 +242,7 @@ int main(int argc, char** argv) {
       if (r == 0) {
         for (InsideCase& c : inside) {
           const Stamp a = Stamp::now();
-          c.builder->update(mapper->map().grid(), f.pose.translation(), sm::KeyBox(), 0, /*force=*/true);
+          c.builder->update(mapper->map().grid(), f.pose.translation(), semx::map::KeyBox(), 0, /*force=*/true);
           c.cpu_ms.push_back(Stamp::now().cpu_ms - a.cpu_ms);
           c.transforms += c.builder->last_inside_transform();
         }
@@ -306,17 +306,17 @@ int main(int argc, char** argv) {
   line("esdf_search_fell_back_frames", static_cast<double>(inside[0].transforms + inside[2].transforms),
        "frames", 0);
   line("esdf_search_vs_transform_max_difference", inside_max_difference, "m", 6);
-  const sm::EsdfGrid& e = ours.esdf();
+  const semx::map::EsdfGrid& e = ours.esdf();
   line("esdf_window_voxels", static_cast<double>(e.distance.size()), "voxels", 0);
   line("delta_voxels_median", percentile(delta_voxels, 0.5), "voxels", 0);
   line("delta_voxels_max", *std::max_element(delta_voxels.begin(), delta_voxels.end()), "voxels", 0);
 
   auto t0 = Clock::now();
-  const sm::MapSnapshot snap = ours.snapshot();
+  const semx::map::MapSnapshot snap = ours.snapshot();
   line("snapshot_encode", ms(t0, Clock::now()), "ms");
   line("snapshot_bytes", static_cast<double>(snap.data.size()), "bytes", 0);
   t0 = Clock::now();
-  const sm::MapStats st = ours.stats(true);
+  const semx::map::MapStats st = ours.stats(true);
   line("stats_with_frontiers", ms(t0, Clock::now()), "ms");
   line("known_volume", st.known_m3, "m3");
   line("frontier_voxels", static_cast<double>(st.frontier_voxels), "voxels", 0);

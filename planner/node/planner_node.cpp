@@ -15,8 +15,8 @@ constexpr int64_t kStatusPeriodUs = static_cast<int64_t>(PlannerNode::kStatusPer
 PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& config)
     : config_(config), node_(std::move(options)), planner_(config) {
   // The map client registers its tick handler first, so the mirror is current when ours runs.
-  map_ = std::make_unique<mapper::MapClient>(node_);
-  map_->on_delta([this](const mapper::MapDelta& d) { planner_.on_map_changes(d.changes); });
+  map_ = std::make_unique<map::MapClient>(node_);
+  map_->on_delta([this](const map::MapDelta& d) { planner_.on_map_changes(d.changes); });
   map_->on_reset([this] { planner_.on_map_reset(); });
   node_.subscribe<semx::odometry_t>(
       semx::channels::ODOMETRY, [this](const semx::odometry_t& m) { planner_.set_pose(to_pose(m)); },

@@ -24,7 +24,7 @@ class PlannerNode {
 
   runtime::Node& node() { return node_; }
   ExplorationPlanner& planner() { return planner_; }
-  const mapper::MapClient& map() const { return *map_; }
+  const map::MapClient& map() const { return *map_; }
   int run() { return node_.run(); }
 
   // One tick of simulation time (what SIM_CLOCK triggers); public for tests.
@@ -38,7 +38,7 @@ class PlannerNode {
 
   PlannerConfig config_;
   runtime::Node node_;
-  std::unique_ptr<mapper::MapClient> map_;
+  std::unique_ptr<map::MapClient> map_;
   ExplorationPlanner planner_;
   int64_t last_utime_ = -1;
   int64_t last_status_utime_ = -1;

@@ -9,7 +9,7 @@
 
 namespace semx::planner {
 
-using mapper::VoxelKey;
+using map::VoxelKey;
 
 AepStrategy::AepStrategy(const PlannerConfig& config)
     : config_(config),
@@ -28,14 +28,14 @@ void AepStrategy::reset() {
   fallback_ = false;
 }
 
-void AepStrategy::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+void AepStrategy::on_map_changes(const std::vector<map::VoxelChange>& changes) {
   global_.on_map_changes(changes);
-  for (const mapper::VoxelChange& c : changes) changed_blocks_.insert(mapper::block_of(c.key));
+  for (const map::VoxelChange& c : changes) changed_blocks_.insert(map::block_of(c.key));
 }
 
-void AepStrategy::on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) {
+void AepStrategy::on_gain_invalidated(const std::vector<map::VoxelKey>& keys) {
   global_.on_gain_invalidated(keys);
-  for (const VoxelKey& k : keys) changed_blocks_.insert(mapper::block_of(k));
+  for (const VoxelKey& k : keys) changed_blocks_.insert(map::block_of(k));
 }
 
 void AepStrategy::on_map_reset() {
@@ -48,7 +48,7 @@ void AepStrategy::mark_cache_stale() {
     cache_.clear();
   } else if (!changed_blocks_.empty() && checker_.grid()) {
     const double res = checker_.grid()->resolution();
-    const double block = mapper::kBlockSize * res;
+    const double block = map::kBlockSize * res;
     const double radius = config_.gain.max_range + 0.5 * block * std::sqrt(3.0) + res;
     for (const VoxelKey& b : changed_blocks_) {
       const Eigen::Vector3d c((b.x + 0.5) * block, (b.y + 0.5) * block, (b.z + 0.5) * block);

@@ -5,12 +5,12 @@
 #include <limits>
 #include <vector>
 
-#include "semx/mapper/raycast.hpp"
+#include "semx/map/raycast.hpp"
 
 namespace semx::planner {
 
-using mapper::VoxelKey;
-using mapper::VoxelState;
+using map::VoxelKey;
+using map::VoxelState;
 
 CollisionChecker::CollisionChecker(const CollisionConfig& config)
     : config_(config),
@@ -29,26 +29,26 @@ namespace {
 // including voxels of blocks never allocated) in the key box [kmin, kmax], block by block, and
 // skips the rows row_wanted(y, z) declines. Stops and returns false when visit returns false.
 template <class RowWanted, class Visit>
-bool for_each_obstacle(const mapper::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
+bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
                        bool unknown_is_obstacle, RowWanted&& row_wanted, Visit&& visit) {
-  const VoxelKey bmin = mapper::block_of(kmin), bmax = mapper::block_of(kmax);
+  const VoxelKey bmin = map::block_of(kmin), bmax = map::block_of(kmax);
   for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
     for (int32_t by = bmin.y; by <= bmax.y; ++by) {
       for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const mapper::VoxelBlock* b = grid.find_block({bx, by, bz});
+        const map::VoxelBlock* b = grid.find_block({bx, by, bz});
         if (!b && !unknown_is_obstacle) continue;
-        const VoxelKey base{bx * mapper::kBlockSize, by * mapper::kBlockSize, bz * mapper::kBlockSize};
+        const VoxelKey base{bx * map::kBlockSize, by * map::kBlockSize, bz * map::kBlockSize};
         const int x0 = std::max(kmin.x, base.x) - base.x,
-                  x1 = std::min(kmax.x, base.x + mapper::kBlockMask) - base.x;
+                  x1 = std::min(kmax.x, base.x + map::kBlockMask) - base.x;
         const int y0 = std::max(kmin.y, base.y) - base.y,
-                  y1 = std::min(kmax.y, base.y + mapper::kBlockMask) - base.y;
+                  y1 = std::min(kmax.y, base.y + map::kBlockMask) - base.y;
         const int z0 = std::max(kmin.z, base.z) - base.z,
-                  z1 = std::min(kmax.z, base.z + mapper::kBlockMask) - base.z;
+                  z1 = std::min(kmax.z, base.z + map::kBlockMask) - base.z;
         for (int z = z0; z <= z1; ++z) {
           for (int y = y0; y <= y1; ++y) {
             if (!row_wanted(base.y + y, base.z + z)) continue;
-            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * mapper::kBlockBits)) |
-                                                                      (y << mapper::kBlockBits))]
+            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
+                                                                      (y << map::kBlockBits))]
                                       : nullptr;
             for (int x = x0; x <= x1; ++x) {
               const VoxelState st = row ? row[x] : VoxelState::kUnknown;
@@ -64,7 +64,7 @@ bool for_each_obstacle(const mapper::StateGrid& grid, const VoxelKey& kmin, cons
 }
 
 // What changes whenever the grid does (changes() alone could repeat after a grid was replaced).
-std::array<uint64_t, 4> stamp_of(const mapper::StateGrid& g) {
+std::array<uint64_t, 4> stamp_of(const map::StateGrid& g) {
   return {g.changes(), static_cast<uint64_t>(g.free_voxels()), static_cast<uint64_t>(g.occupied_voxels()),
           static_cast<uint64_t>(g.num_blocks())};
 }
@@ -97,7 +97,7 @@ int CollisionChecker::reach_for(double cap, double res) {
   return static_cast<int>(std::ceil((cap + std::sqrt(3.0) * res + 0.5 * res) / res));
 }
 
-void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& changes) const {
+void CollisionChecker::note_changes(const std::vector<map::VoxelChange>& changes) const {
   if (!cache_grid_ || changes.empty()) return;
   // A change at v alters the values of centres within `reach` of it: the chunks that hold any
   // voxel of v ± reach. Per changed chunk, the bounding box of its changes grown by reach (3 or 4
@@ -107,7 +107,7 @@ void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& chan
   // A change that keeps a voxel on the same side for a rule (unknown -> occupied for rule 1,
   // unknown -> free for rule 0: most changes at the edge of the known space) leaves that cache
   // as it is. Without the previous state, both go.
-  auto matters = [](int rule, const mapper::VoxelChange& c) {
+  auto matters = [](int rule, const map::VoxelChange& c) {
     if (!c.previous) return true;
     const VoxelState before = *c.previous, after = c.state;
     return rule == 0 ? (before == VoxelState::kOccupied) != (after == VoxelState::kOccupied)
@@ -115,7 +115,7 @@ void CollisionChecker::note_changes(const std::vector<mapper::VoxelChange>& chan
   };
   for (int rule = 0; rule < 2; ++rule) {
     std::unordered_map<uint64_t, std::pair<VoxelKey, VoxelKey>> boxes;
-    for (const mapper::VoxelChange& c : changes) {
+    for (const map::VoxelChange& c : changes) {
       if (!matters(rule, c)) continue;
       auto [it, inserted] = boxes.try_emplace(pack(chunk_of(c.key)), c.key, c.key);
       if (inserted) continue;
@@ -260,7 +260,7 @@ bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector
   for (int i = 0; i < 3; ++i) {
     const double a = std::floor((p[i] - reach[i]) * inv);
     const double b = std::ceil((p[i] + reach[i]) * inv) - 1.0;
-    if (std::abs(a) >= mapper::kMaxKeyMagnitude || std::abs(b) >= mapper::kMaxKeyMagnitude) return false;
+    if (std::abs(a) >= map::kMaxKeyMagnitude || std::abs(b) >= map::kMaxKeyMagnitude) return false;
     kmin[i] = static_cast<int32_t>(a);
     kmax[i] = static_cast<int32_t>(b);
   }
@@ -294,7 +294,7 @@ double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown
   for (int i = 0; i < 3; ++i) {
     const double u = p[i] * inv - 0.5;
     const double fl = std::floor(u);
-    if (std::abs(fl) >= mapper::kMaxKeyMagnitude - 64) return -1.0;
+    if (std::abs(fl) >= map::kMaxKeyMagnitude - 64) return -1.0;
     c0[i] = static_cast<int32_t>(fl);
     f[i] = u - fl;
   }
@@ -354,7 +354,7 @@ bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_ste
       kmax[i] = static_cast<int32_t>(std::ceil((p[i] + reach_[i]) * inv)) - 1;
     }
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
-    mapper::StateGrid::Reader reader = grid_->reader();
+    map::StateGrid::Reader reader = grid_->reader();
     for (int32_t z = kmin.z; z <= kmax.z; ++z)
       for (int32_t y = kmin.y; y <= kmax.y; ++y)
         for (int32_t x = kmin.x; x <= kmax.x; ++x) {
@@ -386,10 +386,10 @@ bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_ste
 bool CollisionChecker::centre_line_free(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                         double skip_radius) const {
   if (!grid_) return false;
-  mapper::StateGrid::Reader r = grid_->reader();
+  map::StateGrid::Reader r = grid_->reader();
   const double skip2 = skip_radius * skip_radius;
-  const mapper::KeyMath& km = grid_->keys();
-  return mapper::traverse_segment(km, a, b, [&](const VoxelKey& k) {
+  const map::KeyMath& km = grid_->keys();
+  return map::traverse_segment(km, a, b, [&](const VoxelKey& k) {
     const VoxelState s = r.state(k);
     if (s == VoxelState::kFree) return true;
     if (s == VoxelState::kOccupied) return false;

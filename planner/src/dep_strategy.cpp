@@ -14,8 +14,8 @@
 
 namespace semx::planner {
 
-using mapper::VoxelKey;
-using mapper::VoxelState;
+using map::VoxelKey;
+using map::VoxelState;
 
 DepStrategy::DepStrategy(const PlannerConfig& config, bool semantic)
     : config_(config),
@@ -38,10 +38,10 @@ void DepStrategy::reset() {
   score_.clear();
 }
 
-void DepStrategy::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+void DepStrategy::on_map_changes(const std::vector<map::VoxelChange>& changes) {
   checker_.note_changes(changes);
-  for (const mapper::VoxelChange& c : changes) {
-    const VoxelKey b = mapper::block_of(c.key);
+  for (const map::VoxelChange& c : changes) {
+    const VoxelKey b = map::block_of(c.key);
     changed_blocks_.insert(b);
     if (c.state != VoxelState::kFree) obstacle_voxels_[b].push_back(c.key);
   }
@@ -49,13 +49,13 @@ void DepStrategy::on_map_changes(const std::vector<mapper::VoxelChange>& changes
 
 void DepStrategy::on_map_reset() { full_reset_ = true; }
 
-void DepStrategy::on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) {
-  for (const VoxelKey& k : keys) changed_blocks_.insert(mapper::block_of(k));
+void DepStrategy::on_gain_invalidated(const std::vector<map::VoxelKey>& keys) {
+  for (const VoxelKey& k : keys) changed_blocks_.insert(map::block_of(k));
 }
 
 bool DepStrategy::obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
                                 double res) const {
-  const double block = mapper::kBlockSize * res;
+  const double block = map::kBlockSize * res;
   const Eigen::Vector3d lo = a.cwiseMin(b).array() - radius, hi = a.cwiseMax(b).array() + radius;
   const Eigen::Vector3d d = b - a;
   const double dd = d.squaredNorm();
@@ -74,11 +74,11 @@ bool DepStrategy::obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d&
 }
 
 void DepStrategy::process_map_changes(PlanContext& ctx) {
-  const mapper::StateGrid& grid = *ctx.grid;
+  const map::StateGrid& grid = *ctx.grid;
   checker_.set_grid(&grid);
   gains_.set_ignored(ctx.unobservable);
   const double res = grid.resolution();
-  const double block = mapper::kBlockSize * res;
+  const double block = map::kBlockSize * res;
   const double half_diag = 0.5 * block * std::sqrt(3.0);
   auto centre = [&](const VoxelKey& b) {
     return Eigen::Vector3d((b.x + 0.5) * block, (b.y + 0.5) * block, (b.z + 0.5) * block);

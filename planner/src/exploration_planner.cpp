@@ -40,14 +40,14 @@ void ExplorationPlanner::reset() {
   strategy_->on_map_reset();
 }
 
-void ExplorationPlanner::set_map(const mapper::StateGrid* grid) {
+void ExplorationPlanner::set_map(const map::StateGrid* grid) {
   if (grid == grid_) return;
   grid_ = grid;
   checker_.set_grid(grid);
   if (grid_) on_map_reset();
 }
 
-void ExplorationPlanner::on_map_changes(const std::vector<mapper::VoxelChange>& changes) {
+void ExplorationPlanner::on_map_changes(const std::vector<map::VoxelChange>& changes) {
   if (!grid_) return;
   frontiers_.update(*grid_, changes);
   strategy_->on_map_changes(changes);
@@ -110,19 +110,19 @@ bool ExplorationPlanner::held_short(int64_t utime) {
   return utime - short_since_ >= static_cast<int64_t>(std::llround(config_.loop.short_hold_s * 1e6));
 }
 
-void ExplorationPlanner::add_unobservable(const std::vector<mapper::VoxelKey>& keys) {
-  for (const mapper::VoxelKey& k : keys) unobservable_.insert(k);
+void ExplorationPlanner::add_unobservable(const std::vector<map::VoxelKey>& keys) {
+  for (const map::VoxelKey& k : keys) unobservable_.insert(k);
   if (strategy_ && !keys.empty()) strategy_->on_gain_invalidated(keys);
 }
 
 void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
   if (!grid_ || !pose_) return;
   core::Stopwatch w;
-  std::vector<mapper::VoxelKey> keys;
+  std::vector<map::VoxelKey> keys;
   GainStats stats;
   gains_.set_ignored(&unobservable_);
   gains_.evaluate(*grid_, pose_->position, pose_->yaw, &keys, &stats);
-  for (const mapper::VoxelKey& k : keys) unobservable_.insert(k);
+  for (const map::VoxelKey& k : keys) unobservable_.insert(k);
   if (!keys.empty()) strategy_->on_gain_invalidated(keys);
   c.gain_evaluations += stats.evaluations;
   c.rays += stats.rays;

@@ -4,8 +4,8 @@
 
 namespace semx::planner {
 
-using mapper::VoxelKey;
-using mapper::VoxelState;
+using map::VoxelKey;
+using map::VoxelState;
 
 FrontierTracker::FrontierTracker(double cluster_size) : cluster_size_(cluster_size) {}
 
@@ -42,10 +42,10 @@ void FrontierTracker::set(const VoxelKey& k, bool frontier) {
   }
 }
 
-void FrontierTracker::recheck(mapper::StateGrid::Reader& r, const VoxelKey& k) {
+void FrontierTracker::recheck(map::StateGrid::Reader& r, const VoxelKey& k) {
   bool frontier = false;
   if (r.state(k) == VoxelState::kUnknown) {
-    for (const VoxelKey& d : mapper::kFaceNeighbours) {
+    for (const VoxelKey& d : map::kFaceNeighbours) {
       if (r.state(k + d) == VoxelState::kFree) {
         frontier = true;
         break;
@@ -55,29 +55,29 @@ void FrontierTracker::recheck(mapper::StateGrid::Reader& r, const VoxelKey& k) {
   set(k, frontier);
 }
 
-void FrontierTracker::update(const mapper::StateGrid& grid, const std::vector<mapper::VoxelChange>& changes) {
+void FrontierTracker::update(const map::StateGrid& grid, const std::vector<map::VoxelChange>& changes) {
   if (resolution_ != grid.resolution()) {
     reset(grid);
     return;
   }
-  mapper::StateGrid::Reader r = grid.reader();
-  for (const mapper::VoxelChange& c : changes) {
+  map::StateGrid::Reader r = grid.reader();
+  for (const map::VoxelChange& c : changes) {
     recheck(r, c.key);
-    for (const VoxelKey& d : mapper::kFaceNeighbours) recheck(r, c.key + d);
+    for (const VoxelKey& d : map::kFaceNeighbours) recheck(r, c.key + d);
   }
 }
 
-void FrontierTracker::reset(const mapper::StateGrid& grid) {
+void FrontierTracker::reset(const map::StateGrid& grid) {
   clear();
   resolution_ = grid.resolution();
-  mapper::StateGrid::Reader r = grid.reader();
+  map::StateGrid::Reader r = grid.reader();
   std::vector<VoxelKey> candidates;
-  grid.for_each_block([&](const VoxelKey& block, const mapper::VoxelBlock& b) {
+  grid.for_each_block([&](const VoxelKey& block, const map::VoxelBlock& b) {
     if (b.known == 0) return;
-    for (int i = 0; i < mapper::kBlockVolume; ++i) {
+    for (int i = 0; i < map::kBlockVolume; ++i) {
       if (b.state[static_cast<size_t>(i)] != VoxelState::kFree) continue;
-      const VoxelKey k = mapper::voxel_of(block, i);
-      for (const VoxelKey& d : mapper::kFaceNeighbours) {
+      const VoxelKey k = map::voxel_of(block, i);
+      for (const VoxelKey& d : map::kFaceNeighbours) {
         if (r.state(k + d) == VoxelState::kUnknown) candidates.push_back(k + d);
       }
     }

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <limits>
 
-#include "semx/mapper/raycast.hpp"
+#include "semx/map/raycast.hpp"
 #include "semx/core/angles.hpp"
 
 namespace semx::planner {
@@ -14,8 +14,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
-using mapper::VoxelKey;
-using mapper::VoxelState;
+using map::VoxelKey;
+using map::VoxelState;
 
 int64_t NodeGain::total_voxels() const {
   int64_t n = 0;
@@ -82,10 +82,10 @@ int GainEvaluator::bin_of(double azimuth) const {
   return std::clamp(b, 0, config_.yaw_bins - 1);
 }
 
-bool GainEvaluator::classify(mapper::StateGrid::Reader& r, const VoxelKey& k, GainVoxel& kind) {
+bool GainEvaluator::classify(map::StateGrid::Reader& r, const VoxelKey& k, GainVoxel& kind) {
   if (r.state(k) != VoxelState::kUnknown) return false;
   bool free = false, occupied = false;
-  for (const VoxelKey& d : mapper::kFaceNeighbours) {
+  for (const VoxelKey& d : map::kFaceNeighbours) {
     const VoxelState s = r.state(k + d);
     free |= s == VoxelState::kFree;
     occupied |= s == VoxelState::kOccupied;
@@ -228,21 +228,21 @@ void GainEvaluator::prepare(double res) {
   const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
   seen_.assign((bits + 63) / 64, 0);
   // Blocks an offset can fall in, relative to the node's block, whatever the node's place in it.
-  block_lo_ = (-hx_) >> mapper::kBlockBits;
-  block_n_ = ((mapper::kBlockMask + hx_) >> mapper::kBlockBits) - block_lo_ + 1;
-  block_lo_z_ = (-hz_) >> mapper::kBlockBits;
-  const int nz = ((mapper::kBlockMask + hz_) >> mapper::kBlockBits) - block_lo_z_ + 1;
+  block_lo_ = (-hx_) >> map::kBlockBits;
+  block_n_ = ((map::kBlockMask + hx_) >> map::kBlockBits) - block_lo_ + 1;
+  block_lo_z_ = (-hz_) >> map::kBlockBits;
+  const int nz = ((map::kBlockMask + hz_) >> map::kBlockBits) - block_lo_z_ + 1;
   block_ptr_.assign(static_cast<size_t>(block_n_) * block_n_ * nz, nullptr);
   block_stamp_.assign(block_ptr_.size(), 0u);
   ignored_ptr_.assign(block_ptr_.size(), nullptr);
   stamp_ = 0;
 }
 
-NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats) {
+NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats) {
   return evaluate(grid, p, 0.0, nullptr, stats);
 }
 
-NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
+NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
                                  std::vector<VoxelKey>* counted, GainStats* stats) {
   const int bins = config_.yaw_bins;
   const int first = counted ? window_of(yaw) : 0;
@@ -250,7 +250,7 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
   NodeGain g;
   g.bin_gain.assign(static_cast<size_t>(config_.yaw_bins), 0.0f);
   g.bin_count.assign(static_cast<size_t>(config_.yaw_bins), {0, 0, 0});
-  const mapper::KeyMath& km = grid.keys();
+  const map::KeyMath& km = grid.keys();
   VoxelKey origin;
   if (!p.allFinite() || !km.key(p, origin)) {
     finish(g);
@@ -263,11 +263,11 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
     std::memset(seen_.data(), 0, seen_.size() * sizeof(uint64_t));
   }
   const int nx = 2 * hx_ + 1;
-  mapper::StateGrid::Reader neighbour_reader = grid.reader();
-  const VoxelKey origin_block = mapper::block_of(origin);
-  const int ox = origin.x & mapper::kBlockMask, oy = origin.y & mapper::kBlockMask,
-            oz = origin.z & mapper::kBlockMask;
-  const mapper::VoxelBlock* origin_b = grid.find_block(origin_block);
+  map::StateGrid::Reader neighbour_reader = grid.reader();
+  const VoxelKey origin_block = map::block_of(origin);
+  const int ox = origin.x & map::kBlockMask, oy = origin.y & map::kBlockMask,
+            oz = origin.z & map::kBlockMask;
+  const map::VoxelBlock* origin_b = grid.find_block(origin_block);
   const bool ignore = ignored_ && !ignored_->empty();
   const VoxelSet::Mask* origin_ignored = ignore ? ignored_->block_mask(origin_block) : nullptr;
   if (++stamp_ == 0) {  // wrapped: forget every stamp
@@ -280,14 +280,14 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
     // The ray's voxels as offsets from the node's voxel (prepare()); the block is looked up only
     // when the offset leaves the one looked up last.
     int cur_bx = 0, cur_by = 0, cur_bz = 0;
-    const mapper::VoxelBlock* b = origin_b;
+    const map::VoxelBlock* b = origin_b;
     const VoxelSet::Mask* ignored_mask = origin_ignored;
     const RayStep* it = &ray_steps_[ray_begin_[ray]];
     const RayStep* const end = &ray_steps_[ray_begin_[ray + 1]];
     for (; it != end; ++it) {
       ++steps;
       const int ux = ox + it->dx, uy = oy + it->dy, uz = oz + it->dz;
-      const int bx = ux >> mapper::kBlockBits, by = uy >> mapper::kBlockBits, bz = uz >> mapper::kBlockBits;
+      const int bx = ux >> map::kBlockBits, by = uy >> map::kBlockBits, bz = uz >> map::kBlockBits;
       if (bx != cur_bx || by != cur_by || bz != cur_bz) {
         cur_bx = bx;
         cur_by = by;
@@ -304,9 +304,9 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
         b = block_ptr_[slot];
         ignored_mask = ignored_ptr_[slot];
       }
-      const int lx = ux & mapper::kBlockMask, ly = uy & mapper::kBlockMask, lz = uz & mapper::kBlockMask;
+      const int lx = ux & map::kBlockMask, ly = uy & map::kBlockMask, lz = uz & map::kBlockMask;
       const size_t li =
-          static_cast<size_t>(lx | (ly << mapper::kBlockBits) | (lz << (2 * mapper::kBlockBits)));
+          static_cast<size_t>(lx | (ly << map::kBlockBits) | (lz << (2 * map::kBlockBits)));
       const VoxelState s = b ? b->state[li] : VoxelState::kUnknown;
       if (s == VoxelState::kOccupied) break;
       if (s != VoxelState::kUnknown) continue;
@@ -322,13 +322,13 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
       const Eigen::Vector3d c = km.center(k) - p;
       GainVoxel kind = GainVoxel::kUnknown;
       bool known_kind = false;
-      if (lx > 0 && ly > 0 && lz > 0 && lx < mapper::kBlockMask && ly < mapper::kBlockMask &&
-          lz < mapper::kBlockMask) {
+      if (lx > 0 && ly > 0 && lz > 0 && lx < map::kBlockMask && ly < map::kBlockMask &&
+          lz < map::kBlockMask) {
         // All six neighbours are in this block: read them directly (an unallocated block is all
         // unknown, so its inner voxels are "normal").
         known_kind = true;
         if (b) {
-          constexpr size_t dy1 = mapper::kBlockSize, dz1 = mapper::kBlockSize * mapper::kBlockSize;
+          constexpr size_t dy1 = map::kBlockSize, dz1 = map::kBlockSize * map::kBlockSize;
           const VoxelState n[6] = {b->state[li - 1],   b->state[li + 1],   b->state[li - dy1],
                                    b->state[li + dy1], b->state[li - dz1], b->state[li + dz1]};
           bool free = false, occupied = false;
@@ -356,18 +356,18 @@ NodeGain GainEvaluator::evaluate(const mapper::StateGrid& grid, const Eigen::Vec
   return g;
 }
 
-NodeGain GainEvaluator::evaluate_exact(const mapper::StateGrid& grid, const Eigen::Vector3d& p) const {
+NodeGain GainEvaluator::evaluate_exact(const map::StateGrid& grid, const Eigen::Vector3d& p) const {
   NodeGain g;
   g.bin_gain.assign(static_cast<size_t>(config_.yaw_bins), 0.0f);
   g.bin_count.assign(static_cast<size_t>(config_.yaw_bins), {0, 0, 0});
-  const mapper::KeyMath& km = grid.keys();
+  const map::KeyMath& km = grid.keys();
   VoxelKey origin;
   if (!p.allFinite() || !km.key(p, origin)) {
     finish(g);
     return g;
   }
   const int h = static_cast<int>(std::ceil(config_.max_range / grid.resolution())) + 1;
-  mapper::StateGrid::Reader r = grid.reader();
+  map::StateGrid::Reader r = grid.reader();
   for (int z = -h; z <= h; ++z) {
     for (int y = -h; y <= h; ++y) {
       for (int x = -h; x <= h; ++x) {

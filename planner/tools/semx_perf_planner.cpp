@@ -25,10 +25,10 @@
 #include "semx/planner/charge_model.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/exploration_planner.hpp"
-#include "semx/planner/exploration_sim.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
 #include "semx/planner/gain_evaluator.hpp"
 #include "semx/core/random.hpp"
-#include "semx/planner/synthetic_world.hpp"
+#include "semx/fixtures/synthetic_world.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
 
@@ -39,7 +39,7 @@
 
 using namespace semx::planner;
 using namespace semx::runtime;
-namespace mapper = semx::mapper;
+namespace map = semx::map;
 
 namespace {
 
@@ -63,16 +63,16 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // The kernels on one map, at points drawn from its free voxels (fixed seed).
-void time_kernels(const mapper::StateGrid& grid, const PlannerConfig& config) {
+void time_kernels(const map::StateGrid& grid, const PlannerConfig& config) {
   semx::core::SplitMixRng rng(1);
-  const mapper::KeyBox box = grid.known_bounds();
+  const map::KeyBox box = grid.known_bounds();
   const double res = grid.resolution();
   std::vector<Eigen::Vector3d> points;
   for (int tries = 0; tries < 200000 && points.size() < 400; ++tries) {
     const Eigen::Vector3d p(rng.uniform(box.min.x * res, (box.max.x + 1) * res),
                             rng.uniform(box.min.y * res, (box.max.y + 1) * res),
                             rng.uniform(box.min.z * res, (box.max.z + 1) * res));
-    if (grid.state(p) == mapper::VoxelState::kFree) points.push_back(p);
+    if (grid.state(p) == map::VoxelState::kFree) points.push_back(p);
   }
   if (points.empty()) {
     std::printf("kernels: no free voxel to time at\n");
@@ -131,7 +131,7 @@ std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resol
   Box interior{w.bounds.min, w.bounds.max};
   auto world = std::make_unique<SyntheticWorld>(
       resolution, interior,
-      [gt](const semx::mapper::VoxelKey& k) {
+      [gt](const semx::map::VoxelKey& k) {
         const Eigen::Vector3i key(k.x, k.y, k.z);
         return gt->in_grid(key) && gt->cell(key) == semx::simulator::GroundTruth::kOccupied;
       },
@@ -201,15 +201,15 @@ int main(int argc, char** argv) {
       o.semantic_weight = semantic_weight;
       o.coverage_period = coverage_period;
       if (oracle) {
-        std::vector<semx::mapper::VoxelKey> keys;
+        std::vector<semx::map::VoxelKey> keys;
         const double r = world->resolution();
         for (const Box& b : world->objects()) {
-          const semx::mapper::KeyMath km(r);
+          const semx::map::KeyMath km(r);
           const auto lo = km.key(b.min), hi = km.key(b.max);
           for (int32_t x = lo.x; x <= hi.x; ++x)
             for (int32_t y = lo.y; y <= hi.y; ++y)
               for (int32_t z = lo.z; z <= hi.z; ++z) {
-                const semx::mapper::VoxelKey k{x, y, z};
+                const semx::map::VoxelKey k{x, y, z};
                 const Eigen::Vector3d c = km.center(k);
                 if (((c - b.min).array() > r).all() && ((b.max - c).array() > r).all() && world->occupied(k))
                   keys.push_back(k);

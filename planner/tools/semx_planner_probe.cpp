@@ -1,11 +1,11 @@
 // semx-planner-probe: what the planner's collision checks say about doorways on a real map (a
-// mapper checkpoint, e.g. from semx-map-replay or semx-mapper --checkpoint, or a run folder's
-// map.bt: a checkpoint changes when the mapper publishes, and so the run). For each doorway it
+// run folder's map.bt, or semx-map-replay's of a log; the planner reads the map's states alone,
+// which is all a .bt keeps, so the probe needs nothing of the mapper). For each doorway it
 // prints horizontal slices of the voxel states with the points where a roadmap node may stand,
 // and how many straight edges through the doorway pass the edge check. Debugging aid for
 // "the roadmap never connects this room" (docs/planner.md, "Narrow passages").
 //
-//   semx-planner-probe MAP.ckpt|map.bt [--door X,Y,AXIS]... [--edge ...]... [--set KEY=VALUE]...
+//   semx-planner-probe map.bt [--door X,Y,AXIS]... [--edge ...]... [--set KEY=VALUE]...
 //
 // AXIS is the axis the wall runs along (x: a wall of constant y, crossed along y). Without
 // --door, env3's doorways.
@@ -17,8 +17,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "semx/mapper/checkpoint.hpp"
-#include "semx/mapper/occupancy_map.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/planner_config.hpp"
 #include "semx/runtime/args.hpp"
@@ -30,17 +29,17 @@ namespace {
 
 // A run folder's map.bt (the evaluator's copy of the map: each known voxel at the clamping
 // log-odds of its state) as voxel states.
-void load_bt(const std::string& path, mapper::StateGrid& grid) {
+void load_bt(const std::string& path, map::StateGrid& grid) {
   octomap::OcTree tree(0.1);
   if (!tree.readBinary(path)) throw runtime::ConfigError(path + ": not an OctoMap binary tree");
   const double res = tree.getResolution();
   if (std::abs(res - grid.resolution()) > 1e-9)
     throw runtime::ConfigError(path + ": resolution " + std::to_string(res) +
                                ", the planner's map has 0.1 m");
-  const mapper::KeyMath km(res);
+  const map::KeyMath km(res);
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const mapper::VoxelState s =
-        tree.isNodeOccupied(*it) ? mapper::VoxelState::kOccupied : mapper::VoxelState::kFree;
+    const map::VoxelState s =
+        tree.isNodeOccupied(*it) ? map::VoxelState::kOccupied : map::VoxelState::kFree;
     const int n = static_cast<int>(std::lround(it.getSize() / res));  // a pruned leaf spans n^3 voxels
     const octomap::point3d c = it.getCoordinate();
     const Eigen::Vector3d lo(c.x() - 0.5 * it.getSize() + 0.5 * res, c.y() - 0.5 * it.getSize() + 0.5 * res,
@@ -48,7 +47,7 @@ void load_bt(const std::string& path, mapper::StateGrid& grid) {
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
-          mapper::VoxelKey k;
+          map::VoxelKey k;
           if (km.key(lo + Eigen::Vector3d(x, y, z) * res, k)) grid.set_state(k, s);
         }
   }
@@ -64,7 +63,7 @@ Eigen::Vector3d at(const Door& d, double along, double across, double z) {
                        : Eigen::Vector3d(d.x + across, d.y + along, z);
 }
 
-void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& checker, const Door& d) {
+void probe(const map::StateGrid& grid, const planner::CollisionChecker& checker, const Door& d) {
   const double res = grid.resolution();
   std::printf("== doorway (%.2f, %.2f) wall along %c\n", d.x, d.y, d.axis);
   for (double z : {0.75, 1.05, 1.35, 1.65}) {
@@ -73,8 +72,8 @@ void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& check
       std::string row = "  ";
       for (double along = -0.9 + 0.5 * res; along < 0.9; along += res) {
         const Eigen::Vector3d p = at(d, along, across, z);
-        const mapper::VoxelState s = grid.state(p);
-        char c = s == mapper::VoxelState::kOccupied ? '#' : s == mapper::VoxelState::kUnknown ? '?' : '.';
+        const map::VoxelState s = grid.state(p);
+        char c = s == map::VoxelState::kOccupied ? '#' : s == map::VoxelState::kUnknown ? '?' : '.';
         if (c == '.' && checker.node_free(p)) c = '+';
         row += c;
       }
@@ -88,18 +87,18 @@ void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& check
     double best_esdf = 0, best_cube = 0;
     for (double along = -0.6; along <= 0.6; along += 0.01) {
       const Eigen::Vector3d q = at(d, along, 0.0, z);
-      const mapper::VoxelKey k = grid.keys().key(q);
+      const map::VoxelKey k = grid.keys().key(q);
       double esdf = 1e9, cube = 1e9;
       for (int dz = -8; dz <= 8; ++dz)
         for (int dy = -8; dy <= 8; ++dy)
           for (int dx = -8; dx <= 8; ++dx) {
-            const mapper::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
-            const mapper::VoxelState s = grid.state(v);
-            if (s == mapper::VoxelState::kFree) continue;
+            const map::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
+            const map::VoxelState s = grid.state(v);
+            if (s == map::VoxelState::kFree) continue;
             const Eigen::Vector3d lo(v.x * res, v.y * res, v.z * res);
             const Eigen::Vector3d c = q.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
             cube = std::min(cube, (q - c).norm());
-            if (s == mapper::VoxelState::kOccupied)
+            if (s == map::VoxelState::kOccupied)
               esdf = std::min(esdf, (q - lo - Eigen::Vector3d::Constant(0.5 * res)).norm());
           }
       best_esdf = std::max(best_esdf, esdf);
@@ -141,21 +140,21 @@ void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& check
         if (checker.node_free(q)) continue;
         std::printf("  edge along %.2f z %.2f: first blocked at (%.2f %.2f %.2f) by", along, z, q.x(), q.y(),
                     q.z());
-        const mapper::KeyMath& km = grid.keys();
-        const mapper::VoxelKey k = km.key(q);
+        const map::KeyMath& km = grid.keys();
+        const map::VoxelKey k = km.key(q);
         double best = 1e9;
         for (int dz = -6; dz <= 6; ++dz)
           for (int dy = -6; dy <= 6; ++dy)
             for (int dx = -6; dx <= 6; ++dx) {
-              const mapper::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
-              const mapper::VoxelState s = grid.state(v);
-              if (s == mapper::VoxelState::kFree) continue;
+              const map::VoxelKey v{k.x + dx, k.y + dy, k.z + dz};
+              const map::VoxelState s = grid.state(v);
+              if (s == map::VoxelState::kFree) continue;
               const Eigen::Vector3d lo(v.x * res, v.y * res, v.z * res);
               const Eigen::Vector3d c = q.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
               const double dist = (q - c).norm();
               best = std::min(best, dist);
               if (dist < 0.40)
-                std::printf(" %s(%.2f %.2f %.2f d%.2f)", s == mapper::VoxelState::kOccupied ? "occ" : "unk",
+                std::printf(" %s(%.2f %.2f %.2f d%.2f)", s == map::VoxelState::kOccupied ? "occ" : "unk",
                             lo.x() + 0.05, lo.y() + 0.05, lo.z() + 0.05, dist);
             }
         std::printf("\n");
@@ -169,11 +168,11 @@ void probe(const mapper::StateGrid& grid, const planner::CollisionChecker& check
 
 int main(int argc, char** argv) {
   return runtime::run_main("semx-planner-probe", [&] {
-    std::string ckpt, config_file;
+    std::string map_file, config_file;
     std::vector<std::string> doors, overrides, edges;
     runtime::ArgParser p("semx-planner-probe",
-                         "Prints the planner's collision checks around doorways of a mapper checkpoint.");
-    p.positional("MAP", "mapper checkpoint (map.ckpt), or a run folder's map.bt", &ckpt)
+                         "Prints the planner's collision checks around doorways of a run's map.bt.");
+    p.positional("MAP", "an OctoMap .bt (a run folder's map.bt, or semx-map-replay's)", &map_file)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
         .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors)
@@ -181,15 +180,8 @@ int main(int argc, char** argv) {
                   &edges);
     if (!p.parse(argc, argv)) return 0;
     const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
-    mapper::OccupancyMap map{mapper::OccupancyParams()};
-    mapper::StateGrid bt_grid(map.grid().resolution());
-    const bool bt = ckpt.size() > 3 && ckpt.compare(ckpt.size() - 3, 3, ".bt") == 0;
-    if (bt) {
-      load_bt(ckpt, bt_grid);
-    } else {
-      mapper::load_checkpoint(ckpt, map);
-    }
-    const mapper::StateGrid& grid = bt ? bt_grid : grid;
+    map::StateGrid grid(0.1);
+    load_bt(map_file, grid);
     planner::CollisionChecker checker(config.collision);
     checker.set_grid(&grid);
     std::vector<Door> list;
@@ -212,9 +204,9 @@ int main(int argc, char** argv) {
         return 2;
       }
       const auto state = [&](const Eigen::Vector3d& q) {
-        const mapper::VoxelState v = grid.state(q);
-        return v == mapper::VoxelState::kFree       ? "free"
-               : v == mapper::VoxelState::kOccupied ? "occupied"
+        const map::VoxelState v = grid.state(q);
+        return v == map::VoxelState::kFree       ? "free"
+               : v == map::VoxelState::kOccupied ? "occupied"
                                                     : "unknown";
       };
       for (const Eigen::Vector3d& q : {a, b})

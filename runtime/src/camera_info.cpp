@@ -29,6 +29,28 @@ semx::camera_info_t to_camera_info(const PinholeCamera& camera, const Eigen::Iso
   return info;
 }
 
+semx::depth_image_t depth_image_message(const PinholeCamera& camera, const Eigen::Isometry3d& T_world_optical,
+                                        const uint16_t* pixels, std::size_t count, int64_t utime,
+                                        int64_t frame_id, ImageCompression codec) {
+  semx::depth_image_t m{};
+  m.utime = utime;
+  m.info = to_camera_info(camera, T_world_optical, frame_id);
+  ImageCompression used;
+  if constexpr (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) {
+    m.depth_data = encode_image(reinterpret_cast<const uint8_t*>(pixels), count * 2, 2, codec, used);
+  } else {
+    std::vector<uint8_t> le(count * 2);
+    for (std::size_t i = 0; i < count; ++i) {
+      le[2 * i] = static_cast<uint8_t>(pixels[i] & 0xFF);
+      le[2 * i + 1] = static_cast<uint8_t>(pixels[i] >> 8);
+    }
+    m.depth_data = encode_image(le, 2, codec, used);
+  }
+  m.compression = static_cast<int8_t>(used);
+  m.num_depth_bytes = static_cast<int32_t>(m.depth_data.size());
+  return m;
+}
+
 std::string from_camera_info(const semx::camera_info_t& info, PinholeCamera& camera,
                              Eigen::Isometry3d& T_world_optical) {
   if (info.width <= 0 || info.height <= 0 ||

@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "frame_messages.hpp"
+#include "simulator_messages.hpp"
 #include "semantics_messages.hpp"
 #include "semantics_sim.hpp"
 #include "semx/runtime/args.hpp"

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "frame_messages.hpp"
+#include "simulator_messages.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::simulator {

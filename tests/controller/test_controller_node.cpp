@@ -5,9 +5,9 @@
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 
-#include "semx/controller/controller_node.hpp"
-#include "semx/controller/message_adapter.hpp"
-#include "semx/controller/synthetic_scene.hpp"
+#include "controller_node.hpp"
+#include "controller_messages.hpp"
+#include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/runtime/channels.hpp"
 
 using namespace semx::controller;

@@ -4,7 +4,7 @@
 
 #include "fields.hpp"
 #include "semx/controller/clearance.hpp"
-#include "semx/controller/synthetic_scene.hpp"
+#include "semx/fixtures/synthetic_scene.hpp"
 #include "vehicle_sim.hpp"
 
 using namespace semx::controller;

@@ -7,7 +7,7 @@
 #include "fields.hpp"
 #include "semx/core/angles.hpp"
 #include "semx/controller/fallback.hpp"
-#include "semx/controller/synthetic_scene.hpp"
+#include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/controller/time_allocation.hpp"
 #include "semx/controller/trajectory_generator.hpp"
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
+#include "semx/map/map_delta.hpp"
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
 
@@ -50,9 +50,9 @@ inline std::string small_world_file(const std::string& dir) {
 // The map a perfect mapper would build, revealed in `n` deltas sweeping along x: every target
 // voxel with its ground-truth state, plus a few voxels outside the target set (every fourth
 // delta is empty). Delta k (seq k+1) is stamped t0 + k * dt.
-inline std::vector<mapper::MapDelta> sweep_deltas(const simulator::GroundTruth& gt, int n, int64_t t0_us,
+inline std::vector<map::MapDelta> sweep_deltas(const simulator::GroundTruth& gt, int n, int64_t t0_us,
                                                   int64_t dt_us) {
-  std::vector<mapper::VoxelKey> keys;
+  std::vector<map::VoxelKey> keys;
   const Eigen::Vector3i lo = gt.min_key(), d = gt.dims();
   for (int x = 0; x < d.x(); ++x) {
     for (int y = 0; y < d.y(); ++y) {
@@ -63,7 +63,7 @@ inline std::vector<mapper::MapDelta> sweep_deltas(const simulator::GroundTruth& 
       }
     }
   }
-  std::vector<mapper::MapDelta> out(static_cast<size_t>(n));
+  std::vector<map::MapDelta> out(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
     out[i].seq = i + 1;
     out[i].utime = t0_us + i * dt_us;
@@ -79,8 +79,8 @@ inline std::vector<mapper::MapDelta> sweep_deltas(const simulator::GroundTruth& 
     const size_t i = full[j * full.size() / keys.size()];
     const Eigen::Vector3i k(keys[j].x, keys[j].y, keys[j].z);
     out[i].changes.push_back({keys[j], gt.cell(k) == simulator::GroundTruth::kOccupied
-                                           ? mapper::VoxelState::kOccupied
-                                           : mapper::VoxelState::kFree});
+                                           ? map::VoxelState::kOccupied
+                                           : map::VoxelState::kFree});
   }
   return out;
 }

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "evaluator_test_util.hpp"
-#include "messages.hpp"
+#include "map_messages.hpp"
 #include "semx/evaluator/coverage_tracker.hpp"
-#include "semx/mapper/map_snapshot.hpp"
+#include "semx/map/map_snapshot.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::evaluator::test {
@@ -74,7 +74,7 @@ inline semx::sim_event_t sim_event(int64_t utime, int8_t type, int64_t count, co
 inline std::vector<SceneEvent> make_scene(const simulator::GroundTruth& gt, const SceneOptions& o) {
   namespace ch = semx::channels;
   const auto deltas = sweep_deltas(gt, o.deltas, 250000, 500000);
-  mapper::StateGrid truth(gt.resolution());
+  map::StateGrid truth(gt.resolution());
   size_t next_delta = 0;
   std::vector<SceneEvent> out;
   out.push_back(scene_event(ch::SIM_EVENT, sim_event(0, semx::sim_event_t::EPISODE_START, 1, "small")));
@@ -113,10 +113,10 @@ inline std::vector<SceneEvent> make_scene(const simulator::GroundTruth& gt, cons
     while (next_delta < deltas.size() && deltas[next_delta].utime < t + o.period_us) {
       const auto& d = deltas[next_delta++];
       for (const auto& c : d.changes) truth.set_state(c.key, c.state);
-      if (d.seq != o.lose_seq) out.push_back(scene_event(ch::MAP_UPDATE, mapper::to_message(d)));
+      if (d.seq != o.lose_seq) out.push_back(scene_event(ch::MAP_UPDATE, map::to_message(d)));
       if (d.seq == o.snapshot_after_seq) {
         out.push_back(scene_event(ch::MAP_SNAPSHOT,
-                                  mapper::to_message(mapper::encode_snapshot(truth, d.seq, d.utime))));
+                                  map::to_message(map::encode_snapshot(truth, d.seq, d.utime))));
       }
     }
   }
@@ -126,7 +126,7 @@ inline std::vector<SceneEvent> make_scene(const simulator::GroundTruth& gt, cons
 // Coverage (covered voxels) after the first n deltas of the sweep, from scratch.
 inline std::vector<int64_t> covered_after(const simulator::GroundTruth& gt, int deltas) {
   const auto ds = sweep_deltas(gt, deltas, 250000, 500000);
-  mapper::StateGrid grid(gt.resolution());
+  map::StateGrid grid(gt.resolution());
   std::vector<int64_t> out{0};
   for (const auto& d : ds) {
     for (const auto& c : d.changes) grid.set_state(c.key, c.state);

@@ -7,8 +7,8 @@
 
 #include "evaluator_test_util.hpp"
 #include "semx/evaluator/coverage_tracker.hpp"
-#include "semx/mapper/map_mirror.hpp"
-#include "semx/mapper/map_snapshot.hpp"
+#include "semx/map/map_mirror.hpp"
+#include "semx/map/map_snapshot.hpp"
 
 namespace semx::evaluator {
 namespace {
@@ -24,14 +24,14 @@ TEST(CoverageTracker, StartsEmptyWithTheGroundTruthsTargetSet) {
   EXPECT_EQ(t.target_count(), static_cast<int64_t>(gt->target_count()));
   EXPECT_EQ(t.covered(), 0);
   EXPECT_EQ(t.coverage(), 0.0);
-  mapper::StateGrid empty(0.1);
+  map::StateGrid empty(0.1);
   EXPECT_EQ(CoverageTracker::count_covered(*gt, empty), 0);
 }
 
 TEST(CoverageTracker, IncrementalCountEqualsBruteForceOnRandomDeltas) {
   const auto gt = small_gt();
   CoverageTracker tracker(gt);
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   std::mt19937 rng(12345);
   // Keys in the ground truth's grid and 3 voxels around it (outside T).
   const Eigen::Vector3i lo = gt->min_key() - Eigen::Vector3i::Constant(3);
@@ -39,18 +39,18 @@ TEST(CoverageTracker, IncrementalCountEqualsBruteForceOnRandomDeltas) {
   std::uniform_int_distribution<int> dx(lo.x(), hi.x()), dy(lo.y(), hi.y()), dz(lo.z(), hi.z());
   std::uniform_int_distribution<int> state(0, 9);  // mostly known states, some back to unknown
   for (int round = 0; round < 120; ++round) {
-    mapper::MapDelta d;
+    map::MapDelta d;
     d.seq = round + 1;
     d.utime = round * 100000;
     d.resolution = 0.1;
-    std::unordered_set<mapper::VoxelKey> used;
+    std::unordered_set<map::VoxelKey> used;
     const int n = 50 + static_cast<int>(rng() % 400);
     for (int i = 0; i < n; ++i) {
-      const mapper::VoxelKey k(dx(rng), dy(rng), dz(rng));
+      const map::VoxelKey k(dx(rng), dy(rng), dz(rng));
       if (!used.insert(k).second) continue;
       const int s = state(rng);
-      const auto vs = s == 0 ? mapper::VoxelState::kUnknown
-                             : (s < 7 ? mapper::VoxelState::kFree : mapper::VoxelState::kOccupied);
+      const auto vs = s == 0 ? map::VoxelState::kUnknown
+                             : (s < 7 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
       d.changes.push_back({k, vs});
       grid.set_state(k, vs);
     }
@@ -69,8 +69,8 @@ TEST(CoverageTracker, IncrementalCountEqualsBruteForceOnRandomDeltas) {
 TEST(CoverageTracker, FollowsAMirrorThroughDeltasAndASnapshotAfterAGap) {
   const auto gt = small_gt();
   const auto deltas = test::sweep_deltas(*gt, 12, 0, 500000);
-  mapper::StateGrid truth(0.1);  // the mapper's map
-  mapper::MapMirror mirror(0.1);
+  map::StateGrid truth(0.1);  // the mapper's map
+  map::MapMirror mirror(0.1);
   CoverageTracker tracker(gt);
   int64_t previous = 0;
   for (const auto& d : deltas) {
@@ -80,10 +80,10 @@ TEST(CoverageTracker, FollowsAMirrorThroughDeltasAndASnapshotAfterAGap) {
       // The client asked; the mapper answers with a snapshot of its map at seq 8.
       mirror.apply(d);  // buffered (gap)
       ASSERT_TRUE(mirror.needs_snapshot());
-      ASSERT_EQ(mirror.apply(mapper::encode_snapshot(truth, 8, d.utime)),
-                mapper::MapMirror::SnapshotResult::kApplied);
+      ASSERT_EQ(mirror.apply(map::encode_snapshot(truth, 8, d.utime)),
+                map::MapMirror::SnapshotResult::kApplied);
       ASSERT_TRUE(tracker.reset(mirror.grid()));
-    } else if (mirror.apply(d) == mapper::MapMirror::DeltaResult::kApplied) {
+    } else if (mirror.apply(d) == map::MapMirror::DeltaResult::kApplied) {
       ASSERT_TRUE(tracker.apply(d));
     }
     if (mirror.needs_snapshot()) continue;
@@ -99,13 +99,13 @@ TEST(CoverageTracker, FollowsAMirrorThroughDeltasAndASnapshotAfterAGap) {
 TEST(CoverageTracker, RefusesAnotherResolution) {
   const auto gt = small_gt();
   CoverageTracker tracker(gt);
-  mapper::MapDelta d;
+  map::MapDelta d;
   d.resolution = 0.2;
-  d.changes.push_back({mapper::VoxelKey(5, 5, 5), mapper::VoxelState::kFree});
+  d.changes.push_back({map::VoxelKey(5, 5, 5), map::VoxelState::kFree});
   EXPECT_FALSE(tracker.apply(d));
   EXPECT_EQ(tracker.covered(), 0);
-  mapper::StateGrid g(0.2);
-  g.set_state({5, 5, 5}, mapper::VoxelState::kFree);
+  map::StateGrid g(0.2);
+  g.set_state({5, 5, 5}, map::VoxelState::kFree);
   EXPECT_FALSE(tracker.reset(g));
   EXPECT_TRUE(tracker.matches(0.1 + 1e-12));
 }
@@ -116,16 +116,16 @@ TEST(CoverageTracker, CountsOnlyTargetVoxels) {
   // The start's voxel is reachable free; a voxel inside the floor slab's interior is not in T.
   const Eigen::Vector3i start = gt->key_of({1.0, 1.2, 0.8});
   ASSERT_TRUE(gt->in_target(start));
-  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kOccupied);
+  tracker.set({start.x(), start.y(), start.z()}, map::VoxelState::kOccupied);
   EXPECT_EQ(tracker.covered(), 1);
-  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kFree);  // still known
+  tracker.set({start.x(), start.y(), start.z()}, map::VoxelState::kFree);  // still known
   EXPECT_EQ(tracker.covered(), 1);
-  tracker.set({start.x(), start.y(), start.z()}, mapper::VoxelState::kUnknown);
+  tracker.set({start.x(), start.y(), start.z()}, map::VoxelState::kUnknown);
   EXPECT_EQ(tracker.covered(), 0);
-  tracker.set({1000, 1000, 1000}, mapper::VoxelState::kFree);  // far outside the world
+  tracker.set({1000, 1000, 1000}, map::VoxelState::kFree);  // far outside the world
   const Eigen::Vector3i wall_far_side = gt->key_of({1.5, -0.15, 0.8});
   ASSERT_FALSE(gt->in_target(wall_far_side));
-  tracker.set({wall_far_side.x(), wall_far_side.y(), wall_far_side.z()}, mapper::VoxelState::kOccupied);
+  tracker.set({wall_far_side.x(), wall_far_side.y(), wall_far_side.z()}, map::VoxelState::kOccupied);
   EXPECT_EQ(tracker.covered(), 0);
 }
 
@@ -137,7 +137,7 @@ TEST(CoverageTracker, ObjectCoverageCountsTheFurnituresSurfaceOnly) {
   const Eigen::Vector3d lo = table.center - 0.5 * table.extent, hi = table.center + 0.5 * table.extent;
   // Brute force: occupied target voxels whose cube overlaps the table's box with some volume.
   int64_t expected = 0;
-  std::vector<mapper::VoxelKey> table_voxels;
+  std::vector<map::VoxelKey> table_voxels;
   const Eigen::Vector3i k0 = gt->min_key(), d = gt->dims();
   for (int z = 0; z < d.z(); ++z)
     for (int y = 0; y < d.y(); ++y)
@@ -155,13 +155,13 @@ TEST(CoverageTracker, ObjectCoverageCountsTheFurnituresSurfaceOnly) {
   // A wall voxel in T counts for coverage, not for the objects; a table voxel for both.
   const Eigen::Vector3i wall = gt->key_of({1.5, -0.05, 0.8});
   ASSERT_TRUE(gt->in_target(wall));
-  tracker.set({wall.x(), wall.y(), wall.z()}, mapper::VoxelState::kOccupied);
+  tracker.set({wall.x(), wall.y(), wall.z()}, map::VoxelState::kOccupied);
   EXPECT_EQ(tracker.covered(), 1);
   EXPECT_EQ(tracker.object_covered(), 0);
-  for (const auto& k : table_voxels) tracker.set(k, mapper::VoxelState::kOccupied);
+  for (const auto& k : table_voxels) tracker.set(k, map::VoxelState::kOccupied);
   EXPECT_EQ(tracker.object_covered(), expected);
   EXPECT_DOUBLE_EQ(tracker.object_coverage(), 1.0);
-  tracker.set(table_voxels.front(), mapper::VoxelState::kUnknown);
+  tracker.set(table_voxels.front(), map::VoxelState::kUnknown);
   EXPECT_EQ(tracker.object_covered(), expected - 1);
   tracker.clear();
   EXPECT_EQ(tracker.object_covered(), 0);

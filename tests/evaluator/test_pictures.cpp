@@ -60,13 +60,13 @@ TEST(CoveragePlot, DrawsTheCurvesAndThe85PercentLine) {
 TEST(MapPicture, ColumnsOverlaysAndTheGroundTruthUnderlay) {
   const simulator::World world = test::small_world();
   const simulator::GroundTruth gt(world, 0.1);
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   // A free column at x = 1.05, y = 1.25 and an occupied voxel above a free one at x = 2.05.
-  for (int z = 2; z < 15; ++z) grid.set_state({10, 12, z}, mapper::VoxelState::kFree);
-  grid.set_state({20, 12, 5}, mapper::VoxelState::kFree);
-  grid.set_state({20, 12, 6}, mapper::VoxelState::kOccupied);
+  for (int z = 2; z < 15; ++z) grid.set_state({10, 12, z}, map::VoxelState::kFree);
+  grid.set_state({20, 12, 5}, map::VoxelState::kFree);
+  grid.set_state({20, 12, 6}, map::VoxelState::kOccupied);
   // Outside the projected heights (the floor slab): not drawn.
-  grid.set_state({5, 5, -1}, mapper::VoxelState::kOccupied);
+  grid.set_state({5, 5, -1}, map::VoxelState::kOccupied);
 
   MapPictureOptions o;
   o.max_side_px = 340;  // 34 columns -> 10 px per column
@@ -111,7 +111,7 @@ TEST(MapPicture, ColumnsOverlaysAndTheGroundTruthUnderlay) {
 TEST(MapPicture, RunPictureDrawsTheTrajectory) {
   const simulator::World world = test::small_world();
   const simulator::GroundTruth gt(world, 0.1);
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   const std::vector<Eigen::Vector3d> traj = {{0.5, 0.5, 1}, {1.5, 0.6, 1}, {2.5, 2.0, 1}};
   MapPicture pic = run_map_picture(grid, world, &gt, traj, "small");
   const Image img = pic.render();

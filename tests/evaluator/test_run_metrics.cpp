@@ -196,7 +196,7 @@ TEST(Evaluation, CoverageFromDeltasAndTheGroundTruthFollowsTheMapsResolution) {
   Evaluation ev(test::small_world(), o);
   const simulator::GroundTruth gt(test::small_world(), 0.1);
   const auto deltas = test::sweep_deltas(gt, 5, kS, kS);  // the 4th is empty
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   for (const auto& d : deltas) {
     for (const auto& c : d.changes) grid.set_state(c.key, c.state);
     ev.on_map_delta(d, grid);

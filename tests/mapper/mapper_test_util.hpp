@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "semx/mapper/map_mirror.hpp"
+#include "semx/map/map_mirror.hpp"
 #include "semx/mapper/mapper.hpp"
-#include "semx/mapper/synthetic_room.hpp"
+#include "semx/fixtures/synthetic_room.hpp"
 
 namespace semx::mapper::test {
 
@@ -84,22 +84,22 @@ inline void octomap_insert(octomap::OcTree& tree, const runtime::PinholeCamera& 
 }
 
 // Fraction of voxels known to either map on which both agree.
-inline double agreement(const StateGrid& grid, octomap::OcTree& tree) {
+inline double agreement(const map::StateGrid& grid, octomap::OcTree& tree) {
   constexpr int32_t kOff = 32768;
   int64_t agree = 0, total = 0;
-  grid.for_each_block([&](const VoxelKey& bk, const VoxelBlock& b) {
-    for (int i = 0; i < kBlockVolume; ++i) {
-      if (b.state[i] == VoxelState::kUnknown) continue;
-      const VoxelKey k = voxel_of(bk, i);
+  grid.for_each_block([&](const map::VoxelKey& bk, const map::VoxelBlock& b) {
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (b.state[i] == map::VoxelState::kUnknown) continue;
+      const map::VoxelKey k = map::voxel_of(bk, i);
       const octomap::OcTreeNode* n = tree.search(octomap::OcTreeKey(k.x + kOff, k.y + kOff, k.z + kOff));
       ++total;
-      if (n && (tree.isNodeOccupied(n) ? VoxelState::kOccupied : VoxelState::kFree) == b.state[i]) ++agree;
+      if (n && (tree.isNodeOccupied(n) ? map::VoxelState::kOccupied : map::VoxelState::kFree) == b.state[i]) ++agree;
     }
   });
   tree.expand();
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     const octomap::OcTreeKey k = it.getKey();
-    if (grid.state(VoxelKey{k[0] - kOff, k[1] - kOff, k[2] - kOff}) == VoxelState::kUnknown) ++total;
+    if (grid.state(map::VoxelKey{k[0] - kOff, k[1] - kOff, k[2] - kOff}) == map::VoxelState::kUnknown) ++total;
   }
   return total ? static_cast<double>(agree) / total : 1.0;
 }

@@ -42,10 +42,10 @@ TEST(Checkpoint, SaveAndReloadRestoresEveryLogOdds) {
   EXPECT_EQ(info.file_bytes, saved.file_bytes);
   EXPECT_TRUE(a.map().grid().same_states(b.map().grid()));
   int64_t compared = 0;
-  a.map().grid().for_each_block([&](const VoxelKey& bk, const VoxelBlock& blk) {
-    for (int i = 0; i < kBlockVolume; ++i) {
-      if (blk.state[i] == VoxelState::kUnknown) continue;
-      const VoxelKey k = voxel_of(bk, i);
+  a.map().grid().for_each_block([&](const map::VoxelKey& bk, const map::VoxelBlock& blk) {
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (blk.state[i] == map::VoxelState::kUnknown) continue;
+      const map::VoxelKey k = map::voxel_of(bk, i);
       ASSERT_EQ(b.map().log_odds(k), blk.log_odds[i]);
       ++compared;
     }
@@ -181,8 +181,8 @@ TEST(Export, PcdHoldsTheOccupiedVoxelCentres) {
       }
       ASSERT_TRUE(in.good()) << i;
       const Eigen::Vector3d c(p[0], p[1], p[2]);
-      const VoxelKey k = a.map().keys().key(c);
-      ASSERT_EQ(a.map().state(k), VoxelState::kOccupied);
+      const map::VoxelKey k = a.map().keys().key(c);
+      ASSERT_EQ(a.map().state(k), map::VoxelState::kOccupied);
       ASSERT_LT((a.map().keys().center(k) - c).norm(), 1e-4);
       ++checked;
     }

@@ -83,7 +83,7 @@ TEST(Config, AnOccupancyMapAloneNeedsOnlyItsOwnParameters) {
   p.resolution = 0.01;
   OccupancyMap map(p);
   map.update({1, 2, 3}, true);
-  EXPECT_EQ(map.state(VoxelKey{1, 2, 3}), VoxelState::kOccupied);
+  EXPECT_EQ(map.state(map::VoxelKey{1, 2, 3}), map::VoxelState::kOccupied);
 }
 
 }  // namespace

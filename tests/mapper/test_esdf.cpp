@@ -10,10 +10,10 @@ namespace semx::mapper {
 namespace {
 
 // Brute-force value of one voxel, by the definition in esdf.hpp.
-float brute_distance(const StateGrid& g, const EsdfGrid& e, int x, int y, int z) {
+float brute_distance(const map::StateGrid& g, const map::EsdfGrid& e, int x, int y, int z) {
   auto obstacle = [&](int i, int j, int k) {
-    const VoxelState s = g.state(e.origin + VoxelKey{i, j, k});
-    return s == VoxelState::kOccupied || (e.unknown_as_occupied && s == VoxelState::kUnknown);
+    const map::VoxelState s = g.state(e.origin + map::VoxelKey{i, j, k});
+    return s == map::VoxelState::kOccupied || (e.unknown_as_occupied && s == map::VoxelState::kUnknown);
   };
   const bool inside = obstacle(x, y, z);
   double best = 1e30;
@@ -38,20 +38,20 @@ TEST(Esdf, MatchesBruteForceOnRandomScenes) {
       p.unknown_as_occupied = unknown_as_occupied;
       EsdfBuilder builder(p, 0.1);
       const Eigen::Vector3d center(0.3, -0.45, 1.0);
-      const VoxelKey o = builder.window_origin(center);
-      StateGrid g(0.1);
+      const map::VoxelKey o = builder.window_origin(center);
+      map::StateGrid g(0.1);
       // Mostly free with scattered obstacles and an unknown corner; a little margin outside the
       // window shows that outside voxels are ignored.
       for (int z = -1; z <= 8; ++z)
         for (int y = -1; y <= 16; ++y)
           for (int x = -1; x <= 20; ++x) {
             const double r = u(rng);
-            const VoxelKey k = o + VoxelKey{x, y, z};
+            const map::VoxelKey k = o + map::VoxelKey{x, y, z};
             if (x < 4 && y < 4 && z < 3) continue;  // unknown
-            g.set_state(k, r < 0.04 ? VoxelState::kOccupied : VoxelState::kFree);
+            g.set_state(k, r < 0.04 ? map::VoxelState::kOccupied : map::VoxelState::kFree);
           }
-      ASSERT_TRUE(builder.update(g, center, KeyBox(), 7));
-      const EsdfGrid& e = builder.grid();
+      ASSERT_TRUE(builder.update(g, center, map::KeyBox(), 7));
+      const map::EsdfGrid& e = builder.grid();
       ASSERT_EQ(e.nx, 20);
       ASSERT_EQ(e.ny, 16);
       ASSERT_EQ(e.nz, 8);
@@ -93,18 +93,18 @@ TEST(Esdf, InsideThickObstaclesSearchAndTransformMatchBruteForce) {
     EsdfBuilder builder(p, 0.1);
     builder.set_inside_search_budget(sc.budget);
     const Eigen::Vector3d center(0.3, -0.45, 1.0);
-    const VoxelKey o = builder.window_origin(center);
+    const map::VoxelKey o = builder.window_origin(center);
     std::vector<std::array<int, 6>> boxes;
     std::uniform_int_distribution<int> corner(-3, 17), size(3, 10);
     for (int b = 0; sc.random_boxes && b < 24; ++b) {
       const int x = corner(rng), y = corner(rng), z = corner(rng) / 2;
       boxes.push_back({x, y, z, x + size(rng), y + size(rng), z + size(rng) / 2});
     }
-    StateGrid g(0.1);
+    map::StateGrid g(0.1);
     for (int z = 0; z < 8; ++z)
       for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 20; ++x) {
-          const VoxelKey k = o + VoxelKey{x, y, z};
+          const map::VoxelKey k = o + map::VoxelKey{x, y, z};
           bool occupied = false;
           if (sc.random_boxes) {
             for (const auto& b : boxes)
@@ -119,11 +119,11 @@ TEST(Esdf, InsideThickObstaclesSearchAndTransformMatchBruteForce) {
             if (sc.unknown_as_occupied && z >= 4) continue;
             occupied = slab || block || bar;
           }
-          g.set_state(k, occupied ? VoxelState::kOccupied : VoxelState::kFree);
+          g.set_state(k, occupied ? map::VoxelState::kOccupied : map::VoxelState::kFree);
         }
-    ASSERT_TRUE(builder.update(g, center, KeyBox(), 1));
+    ASSERT_TRUE(builder.update(g, center, map::KeyBox(), 1));
     EXPECT_EQ(builder.last_inside_transform(), sc.expect_transform) << "budget " << sc.budget;
-    const EsdfGrid& e = builder.grid();
+    const map::EsdfGrid& e = builder.grid();
     int deep = 0;
     for (int z = 0; z < e.nz; ++z)
       for (int y = 0; y < e.ny; ++y)
@@ -144,10 +144,10 @@ TEST(Esdf, InterpolationAndGradientPointAwayFromAnObstacle) {
   p.max_distance = 5.0;
   p.unknown_as_occupied = false;
   EsdfBuilder builder(p, 0.1);
-  StateGrid g(0.1);
-  g.set_state({0, 0, 0}, VoxelState::kOccupied);
-  builder.update(g, Eigen::Vector3d(0.05, 0.05, 0.05), KeyBox(), 1);
-  const EsdfGrid& e = builder.grid();
+  map::StateGrid g(0.1);
+  g.set_state({0, 0, 0}, map::VoxelState::kOccupied);
+  builder.update(g, Eigen::Vector3d(0.05, 0.05, 0.05), map::KeyBox(), 1);
+  const map::EsdfGrid& e = builder.grid();
   double d;
   Eigen::Vector3d grad;
   // At a voxel centre the interpolation is the voxel's value.
@@ -179,18 +179,18 @@ TEST(Esdf, RecomputesOnlyWhenTheWindowMovesOrSomethingInsideChanged) {
   EsdfParams p;
   p.window = {2.0, 2.0, 1.0};
   EsdfBuilder builder(p, 0.1);
-  StateGrid g(0.1);
+  map::StateGrid g(0.1);
   const Eigen::Vector3d c(1.0, 1.0, 1.0);
-  EXPECT_TRUE(builder.update(g, c, KeyBox(), 1));
-  EXPECT_FALSE(builder.update(g, c, KeyBox(), 2));
+  EXPECT_TRUE(builder.update(g, c, map::KeyBox(), 1));
+  EXPECT_FALSE(builder.update(g, c, map::KeyBox(), 2));
   EXPECT_EQ(builder.grid().map_seq, 2) << "still valid for the newer map";
-  KeyBox far;
+  map::KeyBox far;
   far.include({500, 500, 500});
   EXPECT_FALSE(builder.update(g, c, far, 3));
-  KeyBox near;
-  near.include(KeyMath(0.1).key(c));
+  map::KeyBox near;
+  near.include(map::KeyMath(0.1).key(c));
   EXPECT_TRUE(builder.update(g, c, near, 4));
-  EXPECT_TRUE(builder.update(g, c + Eigen::Vector3d(0.1, 0, 0), KeyBox(), 5));
+  EXPECT_TRUE(builder.update(g, c + Eigen::Vector3d(0.1, 0, 0), map::KeyBox(), 5));
   EXPECT_FALSE(builder.update(g, Eigen::Vector3d(std::nan(""), 0, 0), near, 6));
 }
 
@@ -202,7 +202,7 @@ TEST(Esdf, MapperKeepsTheWindowAroundTheVehicle) {
     mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
     ASSERT_TRUE(mapper.update_esdf(f.pose.translation()));
   }
-  const EsdfGrid& e = mapper.esdf();
+  const map::EsdfGrid& e = mapper.esdf();
   EXPECT_EQ(e.nx, 100);
   EXPECT_EQ(e.ny, 100);
   EXPECT_EQ(e.nz, 30);

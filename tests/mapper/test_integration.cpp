@@ -36,14 +36,14 @@ TEST(Integration, SingleRayMarksFreeCellsAndTheEndCell) {
     ASSERT_TRUE(res.report.accepted) << res.report.error;
     const OccupancyMap& map = r.mapper.map();
     for (int x = 0; x < 10; ++x) {
-      EXPECT_EQ(map.state(VoxelKey{x, 0, 0}), VoxelState::kFree) << "x=" << x;
-      EXPECT_EQ(*map.log_odds(VoxelKey{x, 0, 0}), map.miss_log_odds()) << "one observation only";
+      EXPECT_EQ(map.state(map::VoxelKey{x, 0, 0}), map::VoxelState::kFree) << "x=" << x;
+      EXPECT_EQ(*map.log_odds(map::VoxelKey{x, 0, 0}), map.miss_log_odds()) << "one observation only";
     }
-    EXPECT_EQ(map.state(VoxelKey{10, 0, 0}), VoxelState::kOccupied);
-    EXPECT_EQ(*map.log_odds(VoxelKey{10, 0, 0}), map.hit_log_odds());
-    EXPECT_EQ(map.state(VoxelKey{11, 0, 0}), VoxelState::kUnknown);
-    EXPECT_EQ(map.state(VoxelKey{-1, 0, 0}), VoxelState::kUnknown);
-    EXPECT_EQ(map.state(VoxelKey{5, 1, 0}), VoxelState::kUnknown);
+    EXPECT_EQ(map.state(map::VoxelKey{10, 0, 0}), map::VoxelState::kOccupied);
+    EXPECT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), map.hit_log_odds());
+    EXPECT_EQ(map.state(map::VoxelKey{11, 0, 0}), map::VoxelState::kUnknown);
+    EXPECT_EQ(map.state(map::VoxelKey{-1, 0, 0}), map::VoxelState::kUnknown);
+    EXPECT_EQ(map.state(map::VoxelKey{5, 1, 0}), map::VoxelState::kUnknown);
     EXPECT_EQ(map.grid().free_voxels(), 10);
     EXPECT_EQ(map.grid().occupied_voxels(), 1);
     EXPECT_EQ(res.report.hits, 1);
@@ -59,9 +59,9 @@ TEST(Integration, RayBeyondMaxRangeClearsUpToTheRangeWithoutAnObstacle) {
   EXPECT_EQ(res.report.hits, 0);
   const OccupancyMap& map = r.mapper.map();
   // The max-range point x = 5.05 lies in voxel 50, which is not observed (OctoMap's convention).
-  for (int x = 0; x < 50; ++x) EXPECT_EQ(map.state(VoxelKey{x, 0, 0}), VoxelState::kFree) << "x=" << x;
-  EXPECT_EQ(map.state(VoxelKey{50, 0, 0}), VoxelState::kUnknown);
-  EXPECT_EQ(map.state(VoxelKey{70, 0, 0}), VoxelState::kUnknown);
+  for (int x = 0; x < 50; ++x) EXPECT_EQ(map.state(map::VoxelKey{x, 0, 0}), map::VoxelState::kFree) << "x=" << x;
+  EXPECT_EQ(map.state(map::VoxelKey{50, 0, 0}), map::VoxelState::kUnknown);
+  EXPECT_EQ(map.state(map::VoxelKey{70, 0, 0}), map::VoxelState::kUnknown);
   EXPECT_EQ(map.grid().occupied_voxels(), 0);
 }
 
@@ -71,8 +71,8 @@ TEST(Integration, NoReturnPixelsClearFreeSpaceUpToMaxRange) {
   EXPECT_EQ(res.report.no_return, 1);
   EXPECT_EQ(r.mapper.map().grid().free_voxels(), 50);
   EXPECT_EQ(r.mapper.map().grid().occupied_voxels(), 0);
-  EXPECT_EQ(r.mapper.map().state(VoxelKey{49, 0, 0}), VoxelState::kFree);
-  EXPECT_EQ(r.mapper.map().state(VoxelKey{50, 0, 0}), VoxelState::kUnknown);
+  EXPECT_EQ(r.mapper.map().state(map::VoxelKey{49, 0, 0}), map::VoxelState::kFree);
+  EXPECT_EQ(r.mapper.map().state(map::VoxelKey{50, 0, 0}), map::VoxelState::kUnknown);
 }
 
 TEST(Integration, MapperMaxRangeTightensTheCameras) {
@@ -84,7 +84,7 @@ TEST(Integration, MapperMaxRangeTightensTheCameras) {
       mapper.integrate(DepthFrame::view(axis_camera(), looking_along_x({0.05, 0.05, 0.05}), depth));
   EXPECT_EQ(res.report.beyond_range, 1);
   EXPECT_EQ(mapper.map().grid().free_voxels(), 20);
-  EXPECT_EQ(mapper.map().state(VoxelKey{20, 0, 0}), VoxelState::kUnknown);
+  EXPECT_EQ(mapper.map().state(map::VoxelKey{20, 0, 0}), map::VoxelState::kUnknown);
 }
 
 TEST(Integration, InvalidDepthValuesAreIgnoredAndCounted) {
@@ -103,10 +103,10 @@ TEST(Integration, InvalidDepthValuesAreIgnoredAndCounted) {
   EXPECT_EQ(mapper.totals().invalid, 1);
   // All rays run (nearly) along +x: the 2 m return is the only obstacle beyond the 0.5 m one...
   // which "hit wins" keeps occupied although the longer rays cross it.
-  EXPECT_EQ(mapper.map().state(VoxelKey{5, 0, 0}), VoxelState::kOccupied);
-  EXPECT_EQ(mapper.map().state(VoxelKey{20, 0, 0}), VoxelState::kOccupied);
-  EXPECT_EQ(*mapper.map().log_odds(VoxelKey{5, 0, 0}), mapper.map().hit_log_odds());
-  EXPECT_EQ(mapper.map().state(VoxelKey{30, 0, 0}), VoxelState::kFree);  // cleared by the far rays
+  EXPECT_EQ(mapper.map().state(map::VoxelKey{5, 0, 0}), map::VoxelState::kOccupied);
+  EXPECT_EQ(mapper.map().state(map::VoxelKey{20, 0, 0}), map::VoxelState::kOccupied);
+  EXPECT_EQ(*mapper.map().log_odds(map::VoxelKey{5, 0, 0}), mapper.map().hit_log_odds());
+  EXPECT_EQ(mapper.map().state(map::VoxelKey{30, 0, 0}), map::VoxelState::kFree);  // cleared by the far rays
 }
 
 TEST(Integration, EachVoxelGetsOneObservationPerFrameAndHitsWin) {
@@ -118,9 +118,9 @@ TEST(Integration, EachVoxelGetsOneObservationPerFrameAndHitsWin) {
     const std::vector<uint16_t> depth{1000, 2000};
     mapper.integrate(DepthFrame::view(cam, looking_along_x({0.05, 0.05, 0.05}), depth));
     const OccupancyMap& map = mapper.map();
-    EXPECT_EQ(*map.log_odds(VoxelKey{10, 0, 0}), map.hit_log_odds());
-    EXPECT_EQ(*map.log_odds(VoxelKey{20, 0, 0}), map.hit_log_odds());
-    for (int x : {0, 3, 9, 11, 19}) EXPECT_EQ(*map.log_odds(VoxelKey{x, 0, 0}), map.miss_log_odds()) << x;
+    EXPECT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), map.hit_log_odds());
+    EXPECT_EQ(*map.log_odds(map::VoxelKey{20, 0, 0}), map.hit_log_odds());
+    for (int x : {0, 3, 9, 11, 19}) EXPECT_EQ(*map.log_odds(map::VoxelKey{x, 0, 0}), map.miss_log_odds()) << x;
   }
 }
 
@@ -133,8 +133,8 @@ TEST(Integration, AReturnWinsOverAMaxRangeRayEndingInTheSameVoxel) {
     // exactly 5 m, in the same voxel, which must become occupied.
     const std::vector<uint16_t> depth{7000, 5000};
     mapper.integrate(DepthFrame::view(cam, looking_along_x({0.05, 0.05, 0.05}), depth));
-    EXPECT_EQ(mapper.map().state(VoxelKey{50, 0, 0}), VoxelState::kOccupied) << to_string(mode);
-    EXPECT_EQ(mapper.map().state(VoxelKey{49, 0, 0}), VoxelState::kFree);
+    EXPECT_EQ(mapper.map().state(map::VoxelKey{50, 0, 0}), map::VoxelState::kOccupied) << to_string(mode);
+    EXPECT_EQ(mapper.map().state(map::VoxelKey{49, 0, 0}), map::VoxelState::kFree);
   }
 }
 
@@ -142,14 +142,14 @@ TEST(Integration, LogOddsAreClampedSoTheMapCanChangeItsMind) {
   SingleRay r;
   for (int i = 0; i < 40; ++i) r.shoot(1000);
   const OccupancyMap& map = r.mapper.map();
-  EXPECT_FLOAT_EQ(*map.log_odds(VoxelKey{10, 0, 0}), std::log(0.971 / (1 - 0.971)));
-  EXPECT_FLOAT_EQ(*map.log_odds(VoxelKey{3, 0, 0}), std::log(0.1192 / (1 - 0.1192)));
-  EXPECT_EQ(*map.log_odds(VoxelKey{10, 0, 0}), map.max_log_odds());
-  EXPECT_EQ(*map.log_odds(VoxelKey{3, 0, 0}), map.min_log_odds());
+  EXPECT_FLOAT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), std::log(0.971 / (1 - 0.971)));
+  EXPECT_FLOAT_EQ(*map.log_odds(map::VoxelKey{3, 0, 0}), std::log(0.1192 / (1 - 0.1192)));
+  EXPECT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), map.max_log_odds());
+  EXPECT_EQ(*map.log_odds(map::VoxelKey{3, 0, 0}), map.min_log_odds());
   // The obstacle moves 1 m further: the clamped voxel turns free after a bounded number of frames
   // (OctoMap's point of clamping): logit(0.971) = 3.51 over misses of 0.405 -> 9 frames.
   int frames = 0;
-  while (map.state(VoxelKey{10, 0, 0}) == VoxelState::kOccupied && frames < 100) {
+  while (map.state(map::VoxelKey{10, 0, 0}) == map::VoxelState::kOccupied && frames < 100) {
     r.shoot(2000);
     ++frames;
   }
@@ -218,12 +218,12 @@ TEST(Integration, MapGrowsToWhereverTheCameraLooks) {
     const double t = room.cast(pose.translation(), dir);
     // The return lands within a millimetre of the wall, on either side of the voxel boundary.
     const bool wall =
-        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t + 0.01))) == VoxelState::kOccupied ||
-        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t - 0.01))) == VoxelState::kOccupied;
+        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t + 0.01))) == map::VoxelState::kOccupied ||
+        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t - 0.01))) == map::VoxelState::kOccupied;
     EXPECT_TRUE(wall);
-    EXPECT_EQ(mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t * 0.5))), VoxelState::kFree);
+    EXPECT_EQ(mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t * 0.5))), map::VoxelState::kFree);
   }
-  const MapStats s = mapper.stats(false);
+  const map::MapStats s = mapper.stats(false);
   EXPECT_LT(s.bounds_min.x(), -1230.0);
   EXPECT_GT(s.bounds_max.x(), 5.0);
 }
@@ -240,7 +240,7 @@ TEST(Integration, ConfiguredBoundsLimitTheMap) {
   EXPECT_EQ(mapper.map().grid().free_voxels(), 5);
   EXPECT_EQ(mapper.map().grid().occupied_voxels(), 0);
   EXPECT_EQ(res.report.out_of_bounds, 6);
-  EXPECT_EQ(mapper.map().state(VoxelKey{10, 0, 0}), VoxelState::kUnknown);
+  EXPECT_EQ(mapper.map().state(map::VoxelKey{10, 0, 0}), map::VoxelState::kUnknown);
 }
 
 TEST(Integration, PixelStepSkipsPixels) {
@@ -286,16 +286,16 @@ TEST(Integration, FreeAndOccupiedMatchTheRoomsGeometry) {
     mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
   int64_t occupied = 0, free = 0, free_in_solid = 0;
   const double h = 0.05 + 1e-3;
-  mapper.map().grid().for_each_block([&](const VoxelKey& bk, const VoxelBlock& b) {
-    for (int i = 0; i < kBlockVolume; ++i) {
-      if (b.state[i] == VoxelState::kUnknown) continue;
-      const Eigen::Vector3d c = mapper.map().keys().center(voxel_of(bk, i));
+  mapper.map().grid().for_each_block([&](const map::VoxelKey& bk, const map::VoxelBlock& b) {
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (b.state[i] == map::VoxelState::kUnknown) continue;
+      const Eigen::Vector3d c = mapper.map().keys().center(map::voxel_of(bk, i));
       bool touches_solid = false, inside_solid = room.solid(c);
       for (int dx = -1; dx <= 1; dx += 2)
         for (int dy = -1; dy <= 1; dy += 2)
           for (int dz = -1; dz <= 1; dz += 2)
             touches_solid |= room.solid(c + Eigen::Vector3d(dx, dy, dz) * h);
-      if (b.state[i] == VoxelState::kOccupied) {
+      if (b.state[i] == map::VoxelState::kOccupied) {
         ++occupied;
         EXPECT_TRUE(touches_solid) << c.transpose();
       } else {

@@ -1,4 +1,4 @@
-// MapClient against a live MapperNode, over two memq:// nodes joined by a link the test controls:
+// map::MapClient against a live MapperNode, over two memq:// nodes joined by a link the test controls:
 // MAP_UPDATEs are lost on the way, the client asks for snapshots, and its mirror must end equal
 // to the mapper's map, voxel for voxel.
 #include <gtest/gtest.h>
@@ -12,7 +12,8 @@
 #include "map_client.hpp"
 #include "mapper_node.hpp"
 #include "mapper_test_util.hpp"
-#include "messages.hpp"
+#include "map_messages.hpp"
+#include "mapper_messages.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::mapper {
@@ -55,8 +56,8 @@ struct LinkResult {
 // the MAP_UPDATEs whose seq is in `lost`. With `ticks`, SIM_CLOCK goes to the client after each
 // frame (as the simulator's clock would) and the client applies messages on ticks.
 void run_link(const std::vector<test::RoomFrame>& frames, const std::set<int64_t>& lost, bool ticks,
-              MapClientOptions client_options, const std::function<void(MapClient&)>& setup,
-              const std::function<void(const MapperNode&, const MapClient&, const LinkResult&)>& check) {
+              map::MapClientOptions client_options, const std::function<void(map::MapClient&)>& setup,
+              const std::function<void(const MapperNode&, const map::MapClient&, const LinkResult&)>& check) {
   const auto cam = test::small_camera();
   MapperConfig cfg;
   cfg.esdf.enabled = false;
@@ -66,7 +67,7 @@ void run_link(const std::vector<test::RoomFrame>& frames, const std::set<int64_t
   Outbox from_mapper(a, {ch::MAP_UPDATE, ch::MAP_SNAPSHOT});
   Outbox from_client(b, {ch::MAP_REQUEST});
   MapperNode mapper(a, cfg);
-  MapClient client(b, client_options);
+  map::MapClient client(b, client_options);
   if (setup) setup(client);
   LinkResult result;
 
@@ -114,12 +115,12 @@ void run_link(const std::vector<test::RoomFrame>& frames, const std::set<int64_t
   check(mapper, client, result);
 }
 
-void expect_mirror_equals_map(const MapClient& client, const MapperNode& mapper) {
+void expect_mirror_equals_map(const map::MapClient& client, const MapperNode& mapper) {
   ASSERT_TRUE(client.has_mirror());
   EXPECT_TRUE(client.in_sync());
   EXPECT_FALSE(client.mirror().needs_snapshot());
   EXPECT_EQ(client.mirror().seq(), mapper.mapper().seq());
-  VoxelKey diff;
+  map::VoxelKey diff;
   EXPECT_TRUE(client.mirror().grid().same_states(mapper.mapper().map().grid(), &diff))
       << "first difference at " << diff.x << " " << diff.y << " " << diff.z;
   EXPECT_EQ(client.mirror().grid().free_voxels(), mapper.mapper().map().grid().free_voxels());
@@ -129,10 +130,10 @@ void expect_mirror_equals_map(const MapClient& client, const MapperNode& mapper)
 
 TEST(MapClient, MirrorEqualsTheMapAfterLostUpdates) {
   const auto frames = test::room_frames(16, test::small_camera(), 16);
-  MapClientOptions o;  // resolution adopted from the mapper
+  map::MapClientOptions o;  // resolution adopted from the mapper
   run_link(frames, {3, 7, 8, 13}, /*ticks=*/false, o, nullptr,
-           [](const MapperNode& mapper, const MapClient& client, const LinkResult& link) {
-             EXPECT_EQ(client.apply_mode(), MapClientOptions::Apply::kImmediately);
+           [](const MapperNode& mapper, const map::MapClient& client, const LinkResult& link) {
+             EXPECT_EQ(client.apply_mode(), map::MapClientOptions::Apply::kImmediately);
              expect_mirror_equals_map(client, mapper);
              EXPECT_EQ(link.lost, 4);
              EXPECT_EQ(client.mirror().counters().gaps, 3) << "7 and 8 are one gap";
@@ -148,17 +149,17 @@ TEST(MapClient, MirrorEqualsTheMapAfterLostUpdates) {
 
 TEST(MapClient, OnTickModeAppliesHeldMessagesAtTicksAndConverges) {
   const auto frames = test::room_frames(12, test::small_camera(), 12);
-  MapClientOptions o;
+  map::MapClientOptions o;
   o.resolution = 0.1;
   int64_t deltas = 0, resets = 0;
   run_link(
       frames, {2, 9}, /*ticks=*/true, o,
-      [&](MapClient& client) {
-        client.on_delta([&](const MapDelta&) { ++deltas; });
+      [&](map::MapClient& client) {
+        client.on_delta([&](const map::MapDelta&) { ++deltas; });
         client.on_reset([&] { ++resets; });
       },
-      [&](const MapperNode& mapper, const MapClient& client, const LinkResult& link) {
-        EXPECT_EQ(client.apply_mode(), MapClientOptions::Apply::kOnTick) << "a lockstep participant";
+      [&](const MapperNode& mapper, const map::MapClient& client, const LinkResult& link) {
+        EXPECT_EQ(client.apply_mode(), map::MapClientOptions::Apply::kOnTick) << "a lockstep participant";
         expect_mirror_equals_map(client, mapper);
         EXPECT_EQ(link.lost, 2);
         EXPECT_EQ(client.mirror().counters().gaps, 2);
@@ -170,11 +171,11 @@ TEST(MapClient, OnTickModeAppliesHeldMessagesAtTicksAndConverges) {
 
 TEST(MapClient, CallbacksReportAppliedDeltasAndResets) {
   runtime::Node node(memq_node("planner"));
-  MapClientOptions o;
+  map::MapClientOptions o;
   o.resolution = 0.1;
-  MapClient client(node, o);
+  map::MapClient client(node, o);
   int deltas = 0, resets = 0;
-  client.on_delta([&](const MapDelta& d) {
+  client.on_delta([&](const map::MapDelta& d) {
     ++deltas;
     EXPECT_EQ(d.seq, deltas);
   });
@@ -182,40 +183,40 @@ TEST(MapClient, CallbacksReportAppliedDeltasAndResets) {
   EXPECT_EQ(client.counters().requests, 1) << "asks for the map at start";
   EXPECT_FALSE(client.in_sync()) << "has not heard from a mapper";
 
-  MapDelta d1{1, 0, 0.1, {{{0, 0, 0}, VoxelState::kFree}}};
-  node.publish(ch::MAP_UPDATE, to_message(d1));
+  map::MapDelta d1{1, 0, 0.1, {{{0, 0, 0}, map::VoxelState::kFree}}};
+  node.publish(ch::MAP_UPDATE, map::to_message(d1));
   node.drain();
   EXPECT_TRUE(client.in_sync());
   EXPECT_EQ(deltas, 1);
   // seq 3 after 1: a gap. The start-up request is still outstanding (no snapshot came), so the
   // next one waits for request_interval_s (0.5 s) of message time.
-  MapDelta d3{3, 200000, 0.1, {{{2, 0, 0}, VoxelState::kOccupied}}};
-  node.publish(ch::MAP_UPDATE, to_message(d3));
+  map::MapDelta d3{3, 200000, 0.1, {{{2, 0, 0}, map::VoxelState::kOccupied}}};
+  node.publish(ch::MAP_UPDATE, map::to_message(d3));
   node.drain();
   EXPECT_FALSE(client.in_sync());
   EXPECT_EQ(client.counters().requests, 1) << "rate-limited: the start-up request is outstanding";
-  MapDelta d4{4, 600000, 0.1, {{{3, 0, 0}, VoxelState::kFree}}};
-  node.publish(ch::MAP_UPDATE, to_message(d4));
+  map::MapDelta d4{4, 600000, 0.1, {{{3, 0, 0}, map::VoxelState::kFree}}};
+  node.publish(ch::MAP_UPDATE, map::to_message(d4));
   node.drain();
   EXPECT_EQ(client.counters().requests, 2) << "0.6 s of message time later";
   // The answer: the map at seq 2; then 3 and 4 come from the mirror's buffer.
-  StateGrid at2(0.1);
-  at2.set_state({0, 0, 0}, VoxelState::kFree);
-  at2.set_state({1, 0, 0}, VoxelState::kFree);
-  MapSnapshot s = encode_snapshot(at2, 2, 600000);
-  node.publish(ch::MAP_SNAPSHOT, to_message(s));
+  map::StateGrid at2(0.1);
+  at2.set_state({0, 0, 0}, map::VoxelState::kFree);
+  at2.set_state({1, 0, 0}, map::VoxelState::kFree);
+  map::MapSnapshot s = map::encode_snapshot(at2, 2, 600000);
+  node.publish(ch::MAP_SNAPSHOT, map::to_message(s));
   node.drain();
   EXPECT_TRUE(client.in_sync());
   EXPECT_EQ(client.seq(), 4);
   EXPECT_EQ(resets, 1);
   EXPECT_EQ(deltas, 1) << "deltas that came with a snapshot are covered by the reset";
-  EXPECT_EQ(client.mirror().state(VoxelKey{2, 0, 0}), VoxelState::kOccupied);
+  EXPECT_EQ(client.mirror().state(map::VoxelKey{2, 0, 0}), map::VoxelState::kOccupied);
 
   // Malformed map messages are counted by the node and leave the mirror alone.
-  semx::map_update_t bad = to_message(MapDelta{5, 0, 0.1, {{{9, 9, 9}, VoxelState::kFree}}});
+  semx::map_update_t bad = map::to_message(map::MapDelta{5, 0, 0.1, {{{9, 9, 9}, map::VoxelState::kFree}}});
   bad.state[0] = 5;
   node.publish(ch::MAP_UPDATE, bad);
-  semx::map_snapshot_t bad_snap = to_message(s);
+  semx::map_snapshot_t bad_snap = map::to_message(s);
   bad_snap.resolution = -1;
   node.publish(ch::MAP_SNAPSHOT, bad_snap);
   node.drain();
@@ -226,11 +227,11 @@ TEST(MapClient, CallbacksReportAppliedDeltasAndResets) {
 
 TEST(MapClient, FixedResolutionIgnoresAnotherMappersMessages) {
   runtime::Node node(memq_node("planner"));
-  MapClientOptions o;
+  map::MapClientOptions o;
   o.resolution = 0.1;
   o.quiet = true;
-  MapClient client(node, o);
-  node.publish(ch::MAP_UPDATE, to_message(MapDelta{1, 0, 0.2, {{{0, 0, 0}, VoxelState::kFree}}}));
+  map::MapClient client(node, o);
+  node.publish(ch::MAP_UPDATE, map::to_message(map::MapDelta{1, 0, 0.2, {{{0, 0, 0}, map::VoxelState::kFree}}}));
   node.drain();
   EXPECT_EQ(client.counters().resolution_mismatches, 1);
   EXPECT_EQ(client.seq(), 0);

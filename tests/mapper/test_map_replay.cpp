@@ -17,7 +17,8 @@
 
 #include "map_replay.hpp"
 #include "mapper_test_util.hpp"
-#include "messages.hpp"
+#include "map_messages.hpp"
+#include "mapper_messages.hpp"
 #include "semx/mapper/checkpoint.hpp"
 
 namespace semx::mapper {
@@ -105,7 +106,7 @@ TEST(MapReplay, RebuildsTheMapOfTheLoggedFramesAndWritesItsFiles) {
 
   Mapper live(cfg);
   for (const auto& f : frames) live.integrate(DepthFrame::view(cam, f.pose, f.depth));
-  VoxelKey diff;
+  map::VoxelKey diff;
   EXPECT_TRUE(replayed.map().grid().same_states(live.map().grid(), &diff));
   EXPECT_EQ(replayed.seq(), 6);
 

@@ -18,7 +18,8 @@
 
 #include "mapper_node.hpp"
 #include "mapper_test_util.hpp"
-#include "messages.hpp"
+#include "map_messages.hpp"
+#include "mapper_messages.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_url.hpp"
 
@@ -107,8 +108,8 @@ std::string temp_file(const std::string& name) {
   return ::testing::TempDir() + "semx_mnode_" + std::to_string(getpid()) + "_" + name;
 }
 
-void expect_same(const StateGrid& a, const StateGrid& b) {
-  VoxelKey diff;
+void expect_same(const map::StateGrid& a, const map::StateGrid& b) {
+  map::VoxelKey diff;
   EXPECT_TRUE(a.same_states(b, &diff)) << "first difference at " << diff.x << " " << diff.y << " " << diff.z;
   EXPECT_EQ(a.free_voxels(), b.free_voxels());
   EXPECT_EQ(a.occupied_voxels(), b.occupied_voxels());
@@ -124,7 +125,7 @@ TEST(MapperNode, PublishesTheMappersDeltaAndEsdfForEveryFrameAndStatsAt1Hz) {
   Mapper reference(cfg);
 
   const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
-  std::vector<MapDelta> expected;
+  std::vector<map::MapDelta> expected;
   std::vector<std::vector<float>> expected_esdf;
   for (int k = 0; k < 5; ++k) {
     const int64_t utime = k * 33333;
@@ -140,8 +141,8 @@ TEST(MapperNode, PublishesTheMappersDeltaAndEsdfForEveryFrameAndStatsAt1Hz) {
   const auto updates = wire.all<semx::map_update_t>(ch::MAP_UPDATE);
   ASSERT_EQ(updates.size(), 5u);
   for (int k = 0; k < 5; ++k) {
-    MapDelta got;
-    ASSERT_TRUE(from_message(updates[k], got));
+    map::MapDelta got;
+    ASSERT_TRUE(map::from_message(updates[k], got));
     EXPECT_EQ(got.seq, k + 1);
     EXPECT_EQ(got.seq, expected[k].seq);
     EXPECT_EQ(got.utime, k * 33333);
@@ -172,8 +173,8 @@ TEST(MapperNode, PublishesTheMappersDeltaAndEsdfForEveryFrameAndStatsAt1Hz) {
     EXPECT_EQ(e.distance, expected_esdf[k]) << "frame " << k;
   }
   // The message converts back into the same field (origin key, layout, queries).
-  EsdfGrid g;
-  ASSERT_TRUE(from_message(esdfs.back(), g));
+  map::EsdfGrid g;
+  ASSERT_TRUE(map::from_message(esdfs.back(), g));
   EXPECT_EQ(g.origin, reference.esdf().origin);
   for (const Eigen::Vector3d& p : {vehicle, Eigen::Vector3d(2.2, 1.9, 0.8), Eigen::Vector3d(4.1, 3.3, 1.9)}) {
     double d = 0, d_ref = 1;
@@ -194,7 +195,7 @@ TEST(MapperNode, PublishesTheMappersDeltaAndEsdfForEveryFrameAndStatsAt1Hz) {
   ASSERT_EQ(stats.size(), 3u) << "t = 0, 1.0 and 2.0 s";
   EXPECT_EQ(stats[1].utime, 1000000);
   EXPECT_EQ(stats[2].utime, 2000000);
-  const MapStats ref = reference.stats();
+  const map::MapStats ref = reference.stats();
   EXPECT_EQ(stats[2].seq, 5);
   EXPECT_EQ(stats[2].free_voxels, ref.free_voxels);
   EXPECT_EQ(stats[2].occupied_voxels, ref.occupied_voxels);
@@ -341,20 +342,20 @@ TEST(MapperNode, MapRequestIsAnsweredWithTheWholeMap) {
   for (int k = 0; k < 3; ++k) node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[k], k * 33333));
   node.drain();
   EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 0) << "snapshot_period 0: only on request";
-  node.publish(ch::MAP_REQUEST, request_message("planner", -1, 0));
+  node.publish(ch::MAP_REQUEST, map::request_message("planner", -1, 0));
   node.drain();
   const auto snaps = wire.all<semx::map_snapshot_t>(ch::MAP_SNAPSHOT);
   ASSERT_EQ(snaps.size(), 1u);
   EXPECT_EQ(snaps[0].seq, 3);
   EXPECT_EQ(snaps[0].utime, 66666);
-  EXPECT_EQ(snaps[0].encoding, kSnapshotBlocksZlib);
-  StateGrid copy(0.1);
-  decode_snapshot(from_message(snaps[0]), copy);
+  EXPECT_EQ(snaps[0].encoding, map::kSnapshotBlocksZlib);
+  map::StateGrid copy(0.1);
+  map::decode_snapshot(map::from_message(snaps[0]), copy);
   expect_same(copy, mn.mapper().map().grid());
   EXPECT_EQ(mn.counters().requests, 1);
 
   // A request that is not a request (last_seq below -1) is malformed, not answered.
-  node.publish(ch::MAP_REQUEST, request_message("planner", -7, 0));
+  node.publish(ch::MAP_REQUEST, map::request_message("planner", -7, 0));
   node.drain();
   EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 1);
   EXPECT_EQ(node.counters().malformed, 1);
@@ -443,7 +444,7 @@ TEST(MapperNode, LockstepDelayPublishesAFramesOutputsAtAFixedLaterTick) {
   Mapper reference(cfg);
   const Eigen::Vector3d vehicle(3.0, 2.5, 1.3);
   const std::vector<int64_t> frame_ticks = {3, 7, 10, 13};
-  std::vector<MapDelta> expected;
+  std::vector<map::MapDelta> expected;
   std::vector<std::vector<float>> expected_esdf;
   node.publish(ch::SIM_CLOCK, clock_at(0, 0, true));
   node.drain();
@@ -488,8 +489,8 @@ TEST(MapperNode, LockstepDelayPublishesAFramesOutputsAtAFixedLaterTick) {
   const std::vector<int64_t> publish_ticks = {7, 11, 14, 15};
   for (size_t k = 0; k < 4; ++k) {
     SCOPED_TRACE("frame " + std::to_string(k));
-    MapDelta got;
-    ASSERT_TRUE(from_message(updates[k], got));
+    map::MapDelta got;
+    ASSERT_TRUE(map::from_message(updates[k], got));
     EXPECT_EQ(got.seq, expected[k].seq);
     EXPECT_EQ(got.utime, frame_ticks[k] * 10000);
     ASSERT_EQ(got.changes.size(), expected[k].changes.size());
@@ -595,7 +596,7 @@ TEST(MapperNode, LockstepOutputsPrecedeTheAckAndRequestsWaitForTheNextTick) {
   EXPECT_EQ(wire.all<semx::ack_t>(ch::SIM_ACK)[0].tick, 0);
 
   // A request between ticks: answered by the tick-1 handler, before SIM_ACK(1).
-  node.publish(ch::MAP_REQUEST, request_message("planner", -1, 0));
+  node.publish(ch::MAP_REQUEST, map::request_message("planner", -1, 0));
   node.drain();
   EXPECT_EQ(wire.count(ch::MAP_SNAPSHOT), 0) << "held for the next tick";
   node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[1], 10000));

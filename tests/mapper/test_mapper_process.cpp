@@ -15,7 +15,8 @@
 
 #include "../tools/process_harness.hpp"
 #include "mapper_test_util.hpp"
-#include "messages.hpp"
+#include "map_messages.hpp"
+#include "mapper_messages.hpp"
 #include "semx/mapper/checkpoint.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/node.hpp"
@@ -95,7 +96,7 @@ TEST(MapperProcess, MapsSurvivesHostileInputAndCheckpointsOnExit) {
     obs.node.publish(semx::channels::CAMERA_DEPTH,
                      depth_message(DepthFrame::view(cam, frames[0].pose, frames[0].depth, 1000), true));
     ASSERT_TRUE(obs.until([&] { return obs.update_seq == 1; }, 5.0)) << "no MAP_UPDATE\n" << read_file(log);
-    obs.node.publish(semx::channels::MAP_REQUEST, request_message("observer", -1, 0));
+    obs.node.publish(semx::channels::MAP_REQUEST, map::request_message("observer", -1, 0));
     ASSERT_TRUE(obs.until([&] { return obs.snapshot_seq == 1; }, 5.0)) << "no MAP_SNAPSHOT";
     // A fresh status after all of it.
     obs.seen = false;

@@ -1,4 +1,4 @@
-// The map queries every consumer uses (StateGrid, shared by the mapper's map and its mirrors).
+// The map queries every consumer uses (map::StateGrid, shared by the mapper's map and its mirrors).
 #include <gtest/gtest.h>
 
 #include <random>
@@ -8,10 +8,10 @@
 namespace semx::mapper {
 namespace {
 
-constexpr VoxelState U = VoxelState::kUnknown, F = VoxelState::kFree, O = VoxelState::kOccupied;
+constexpr map::VoxelState U = map::VoxelState::kUnknown, F = map::VoxelState::kFree, O = map::VoxelState::kOccupied;
 
 TEST(Queries, FrontierIsUnknownWithAFreeFaceNeighbour) {
-  StateGrid g(0.1);
+  map::StateGrid g(0.1);
   g.set_state({0, 0, 0}, F);
   EXPECT_TRUE(g.is_frontier({1, 0, 0}));
   EXPECT_TRUE(g.is_frontier({0, 0, -1}));
@@ -30,7 +30,7 @@ TEST(Queries, FrontierIsUnknownWithAFreeFaceNeighbour) {
 TEST(Queries, FrontierCountMatchesBruteForceAcrossBlockBorders) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 4; ++trial) {
-    StateGrid g(0.1);
+    map::StateGrid g(0.1);
     std::uniform_real_distribution<double> u(0, 1);
     // A region straddling block borders (blocks are 16 voxels), sparse enough to leave unknown
     // voxels in unallocated blocks next to free ones.
@@ -48,9 +48,9 @@ TEST(Queries, FrontierCountMatchesBruteForceAcrossBlockBorders) {
     for (int z = lo - 1; z <= hi + 1; ++z)
       for (int y = lo - 1; y <= hi + 1; ++y)
         for (int x = lo - 1; x <= hi + 1; ++x) {
-          if (g.state(VoxelKey{x, y, z}) != U) continue;
+          if (g.state(map::VoxelKey{x, y, z}) != U) continue;
           bool f = false;
-          for (const VoxelKey& d : kFaceNeighbours) f |= g.state(VoxelKey{x, y, z} + d) == F;
+          for (const map::VoxelKey& d : map::kFaceNeighbours) f |= g.state(map::VoxelKey{x, y, z} + d) == F;
           brute += f;
         }
     EXPECT_EQ(g.count_frontiers(), brute) << "trial " << trial;
@@ -58,7 +58,7 @@ TEST(Queries, FrontierCountMatchesBruteForceAcrossBlockBorders) {
 }
 
 TEST(Queries, RayVisibilityStopsAtObstacles) {
-  StateGrid g(0.1);
+  map::StateGrid g(0.1);
   for (int x = 0; x < 20; ++x) g.set_state({x, 0, 0}, F);
   const Eigen::Vector3d a(0.05, 0.05, 0.05), b(1.95, 0.05, 0.05);
   EXPECT_TRUE(g.is_visible(a, b));
@@ -72,7 +72,7 @@ TEST(Queries, RayVisibilityStopsAtObstacles) {
   EXPECT_FALSE(g.is_visible(a, b, /*unknown_blocks=*/true));
   EXPECT_FALSE(g.is_visible(a, Eigen::Vector3d(std::nan(""), 0, 0)));
   // A diagonal line of sight passes through the voxels it touches, and not around them.
-  StateGrid d(0.1);
+  map::StateGrid d(0.1);
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 10; ++j) d.set_state({i, j, 0}, F);
   d.set_state({5, 5, 0}, O);
@@ -81,24 +81,24 @@ TEST(Queries, RayVisibilityStopsAtObstacles) {
 }
 
 TEST(Queries, TraversalVisitsA6ConnectedPathFromStartToEnd) {
-  const KeyMath km(0.1);
+  const map::KeyMath km(0.1);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-3, 3);
   for (int i = 0; i < 200; ++i) {
     const Eigen::Vector3d a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
-    std::vector<VoxelKey> path;
-    ASSERT_TRUE(traverse_segment(km, a, b, [&](const VoxelKey& k) {
+    std::vector<map::VoxelKey> path;
+    ASSERT_TRUE(map::traverse_segment(km, a, b, [&](const map::VoxelKey& k) {
       path.push_back(k);
       return true;
     }));
     ASSERT_EQ(path.front(), km.key(a));
     ASSERT_EQ(path.back(), km.key(b));
     for (size_t j = 1; j < path.size(); ++j) {
-      const VoxelKey d = path[j] - path[j - 1];
+      const map::VoxelKey d = path[j] - path[j - 1];
       ASSERT_EQ(std::abs(d.x) + std::abs(d.y) + std::abs(d.z), 1);
     }
     // Every voxel on the path is within a voxel diagonal of the segment.
-    for (const VoxelKey& k : path) {
+    for (const map::VoxelKey& k : path) {
       const Eigen::Vector3d c = km.center(k);
       const double t = std::clamp((c - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
       ASSERT_LE((a + t * (b - a) - c).norm(), 0.0867);
@@ -107,7 +107,7 @@ TEST(Queries, TraversalVisitsA6ConnectedPathFromStartToEnd) {
 }
 
 TEST(Queries, BoxCollisionCountsOverlappingVoxelsOnly) {
-  StateGrid g(0.1);
+  map::StateGrid g(0.1);
   for (int z = -5; z < 5; ++z)
     for (int y = -5; y < 5; ++y)
       for (int x = -5; x < 40; ++x) g.set_state({x, y, z}, F);
@@ -131,17 +131,17 @@ TEST(Queries, BoxCollisionCountsOverlappingVoxelsOnly) {
 TEST(Queries, MirrorAndMapAnswerTheSame) {
   const runtime::PinholeCamera cam = test::small_camera();
   Mapper mapper{MapperConfig{}};
-  MapMirror mirror(0.1);
+  map::MapMirror mirror(0.1);
   for (const auto& f : test::room_frames(6, cam, 6)) {
     const FrameResult r = mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
-    ASSERT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kApplied);
+    ASSERT_EQ(mirror.apply(r.delta), map::MapMirror::DeltaResult::kApplied);
   }
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> x(-0.5, 6.5), y(-0.5, 5.5), z(-0.3, 3.0);
   const OccupancyMap& map = mapper.map();
   for (int i = 0; i < 2000; ++i) {
     const Eigen::Vector3d a(x(rng), y(rng), z(rng)), b(x(rng), y(rng), z(rng));
-    const VoxelKey k = map.keys().key(a);
+    const map::VoxelKey k = map.keys().key(a);
     ASSERT_EQ(mirror.state(k), map.state(k));
     ASSERT_EQ(mirror.is_frontier(k), map.is_frontier(k));
     ASSERT_EQ(mirror.is_surface(k), map.is_surface(k));

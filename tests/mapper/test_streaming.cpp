@@ -9,8 +9,8 @@
 namespace semx::mapper {
 namespace {
 
-void expect_same(const StateGrid& a, const StateGrid& b) {
-  VoxelKey diff;
+void expect_same(const map::StateGrid& a, const map::StateGrid& b) {
+  map::VoxelKey diff;
   const bool same = a.same_states(b, &diff);
   EXPECT_TRUE(same) << "first difference at " << diff.x << " " << diff.y << " " << diff.z << ": "
                     << to_string(a.state(diff)) << " vs " << to_string(b.state(diff));
@@ -22,41 +22,41 @@ TEST(Streaming, SnapshotRoundTripIsExact) {
   const runtime::PinholeCamera cam = test::small_camera();
   Mapper mapper{MapperConfig{}};
   for (const auto& f : test::room_frames(6, cam, 6)) mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
-  const MapSnapshot snap = mapper.snapshot(123);
+  const map::MapSnapshot snap = mapper.snapshot(123);
   EXPECT_EQ(snap.seq, 6);
   EXPECT_EQ(snap.utime, 123);
-  EXPECT_EQ(snap.encoding, kSnapshotBlocksZlib);
-  StateGrid copy(0.1);
-  decode_snapshot(snap, copy);
+  EXPECT_EQ(snap.encoding, map::kSnapshotBlocksZlib);
+  map::StateGrid copy(0.1);
+  map::decode_snapshot(snap, copy);
   expect_same(mapper.map().grid(), copy);
   EXPECT_EQ(copy.count_frontiers(), mapper.map().count_frontiers());
   // Deterministic: the same map encodes to the same bytes; and it is compressed.
-  EXPECT_EQ(encode_snapshot(copy, 6, 123).data, snap.data);
+  EXPECT_EQ(map::encode_snapshot(copy, 6, 123).data, snap.data);
   EXPECT_LT(snap.data.size(), static_cast<size_t>(mapper.map().grid().known_voxels() / 4));
 }
 
 TEST(Streaming, EmptyMapSnapshot) {
-  StateGrid empty(0.1), out(0.1);
-  out.set_state({1, 2, 3}, VoxelState::kFree);
-  decode_snapshot(encode_snapshot(empty, 0), out);
+  map::StateGrid empty(0.1), out(0.1);
+  out.set_state({1, 2, 3}, map::VoxelState::kFree);
+  map::decode_snapshot(map::encode_snapshot(empty, 0), out);
   EXPECT_EQ(out.known_voxels(), 0);
-  EXPECT_EQ(out.state(VoxelKey{1, 2, 3}), VoxelState::kUnknown);
+  EXPECT_EQ(out.state(map::VoxelKey{1, 2, 3}), map::VoxelState::kUnknown);
 }
 
 TEST(Streaming, MalformedSnapshotsAreRejectedAndLeaveTheMirrorAlone) {
-  StateGrid g(0.1);
-  for (int i = 0; i < 50; ++i) g.set_state({i, -i, 2 * i}, i % 3 ? VoxelState::kFree : VoxelState::kOccupied);
-  const MapSnapshot good = encode_snapshot(g, 5);
-  MapMirror mirror(0.1);
-  ASSERT_EQ(mirror.apply(good), MapMirror::SnapshotResult::kApplied);
+  map::StateGrid g(0.1);
+  for (int i = 0; i < 50; ++i) g.set_state({i, -i, 2 * i}, i % 3 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
+  const map::MapSnapshot good = map::encode_snapshot(g, 5);
+  map::MapMirror mirror(0.1);
+  ASSERT_EQ(mirror.apply(good), map::MapMirror::SnapshotResult::kApplied);
 
-  auto rejected = [&](MapSnapshot s, const char* what) {
+  auto rejected = [&](map::MapSnapshot s, const char* what) {
     s.seq = 9;  // newer, so that only its content can make the mirror refuse it
-    EXPECT_EQ(mirror.apply(s), MapMirror::SnapshotResult::kRejected) << what;
+    EXPECT_EQ(mirror.apply(s), map::MapMirror::SnapshotResult::kRejected) << what;
     EXPECT_EQ(mirror.seq(), 5) << what;
     expect_same(mirror.grid(), g);
   };
-  MapSnapshot s = good;
+  map::MapSnapshot s = good;
   s.data.resize(s.data.size() / 2);
   rejected(s, "truncated");
   s = good;
@@ -81,16 +81,16 @@ TEST(Streaming, MalformedSnapshotsAreRejectedAndLeaveTheMirrorAlone) {
 TEST(Streaming, MirrorFollowsEveryDelta) {
   const runtime::PinholeCamera cam = test::small_camera();
   Mapper mapper{MapperConfig{}};
-  MapMirror mirror(0.1);
+  map::MapMirror mirror(0.1);
   for (const auto& f : test::room_frames(5, cam, 5)) {
     const FrameResult r = mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
-    std::vector<VoxelState> before;
-    for (const VoxelChange& c : r.delta.changes) before.push_back(mirror.grid().state(c.key));
-    ASSERT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kApplied);
+    std::vector<map::VoxelState> before;
+    for (const map::VoxelChange& c : r.delta.changes) before.push_back(mirror.grid().state(c.key));
+    ASSERT_EQ(mirror.apply(r.delta), map::MapMirror::DeltaResult::kApplied);
     ASSERT_EQ(mirror.seq(), mapper.seq());
     expect_same(mirror.grid(), mapper.map().grid());
     // What it hands on: the same changes, each with the state it replaced.
-    const MapDelta& applied = mirror.last_applied();
+    const map::MapDelta& applied = mirror.last_applied();
     EXPECT_EQ(applied.seq, r.delta.seq);
     ASSERT_EQ(applied.changes.size(), r.delta.changes.size());
     for (size_t i = 0; i < applied.changes.size(); ++i) {
@@ -107,9 +107,9 @@ TEST(Streaming, MirrorFollowsEveryDelta) {
 TEST(Streaming, MirrorRecoversFromLostDeltasBySnapshot) {
   const runtime::PinholeCamera cam = test::small_camera();
   Mapper mapper{MapperConfig{}};
-  MapMirror mirror(0.1);
+  map::MapMirror mirror(0.1);
   const std::set<int64_t> lost = {3, 7, 8, 15};
-  std::deque<MapSnapshot> in_flight;  // snapshot requests are answered with a delay
+  std::deque<map::MapSnapshot> in_flight;  // snapshot requests are answered with a delay
   int requests = 0;
   bool requested = false;
   for (const auto& f : test::room_frames(20, cam, 20)) {
@@ -145,34 +145,34 @@ TEST(Streaming, MirrorRecoversFromLostDeltasBySnapshot) {
 }
 
 TEST(Streaming, MirrorRefusesDeltasAfterAGapUntilASnapshot) {
-  MapMirror mirror(0.1);
-  MapDelta d1{1, 0, 0.1, {{{0, 0, 0}, VoxelState::kFree}}};
-  MapDelta d3{3, 0, 0.1, {{{2, 0, 0}, VoxelState::kOccupied}}};
-  EXPECT_EQ(mirror.apply(d1), MapMirror::DeltaResult::kApplied);
-  EXPECT_EQ(mirror.apply(d3), MapMirror::DeltaResult::kBuffered);
+  map::MapMirror mirror(0.1);
+  map::MapDelta d1{1, 0, 0.1, {{{0, 0, 0}, map::VoxelState::kFree}}};
+  map::MapDelta d3{3, 0, 0.1, {{{2, 0, 0}, map::VoxelState::kOccupied}}};
+  EXPECT_EQ(mirror.apply(d1), map::MapMirror::DeltaResult::kApplied);
+  EXPECT_EQ(mirror.apply(d3), map::MapMirror::DeltaResult::kBuffered);
   EXPECT_TRUE(mirror.needs_snapshot());
-  EXPECT_EQ(mirror.state(VoxelKey{2, 0, 0}), VoxelState::kUnknown) << "not applied across the gap";
-  MapDelta d4{4, 0, 0.1, {{{3, 0, 0}, VoxelState::kFree}}};
-  EXPECT_EQ(mirror.apply(d4), MapMirror::DeltaResult::kBuffered);
+  EXPECT_EQ(mirror.state(map::VoxelKey{2, 0, 0}), map::VoxelState::kUnknown) << "not applied across the gap";
+  map::MapDelta d4{4, 0, 0.1, {{{3, 0, 0}, map::VoxelState::kFree}}};
+  EXPECT_EQ(mirror.apply(d4), map::MapMirror::DeltaResult::kBuffered);
   // The mapper's map at seq 2, as a snapshot: then 3 and 4 are applied from the buffer.
-  StateGrid at2(0.1);
-  at2.set_state({0, 0, 0}, VoxelState::kFree);
-  at2.set_state({1, 0, 0}, VoxelState::kFree);
-  EXPECT_EQ(mirror.apply(encode_snapshot(at2, 2)), MapMirror::SnapshotResult::kApplied);
+  map::StateGrid at2(0.1);
+  at2.set_state({0, 0, 0}, map::VoxelState::kFree);
+  at2.set_state({1, 0, 0}, map::VoxelState::kFree);
+  EXPECT_EQ(mirror.apply(map::encode_snapshot(at2, 2)), map::MapMirror::SnapshotResult::kApplied);
   EXPECT_FALSE(mirror.needs_snapshot());
   EXPECT_EQ(mirror.seq(), 4);
-  EXPECT_EQ(mirror.state(VoxelKey{1, 0, 0}), VoxelState::kFree);
-  EXPECT_EQ(mirror.state(VoxelKey{2, 0, 0}), VoxelState::kOccupied);
-  EXPECT_EQ(mirror.state(VoxelKey{3, 0, 0}), VoxelState::kFree);
+  EXPECT_EQ(mirror.state(map::VoxelKey{1, 0, 0}), map::VoxelState::kFree);
+  EXPECT_EQ(mirror.state(map::VoxelKey{2, 0, 0}), map::VoxelState::kOccupied);
+  EXPECT_EQ(mirror.state(map::VoxelKey{3, 0, 0}), map::VoxelState::kFree);
   // An old snapshot is ignored while in sequence.
-  EXPECT_EQ(mirror.apply(encode_snapshot(at2, 2)), MapMirror::SnapshotResult::kIgnored);
+  EXPECT_EQ(mirror.apply(map::encode_snapshot(at2, 2)), map::MapMirror::SnapshotResult::kIgnored);
   // Wrong resolution and out-of-range keys are rejected without touching the mirror.
-  MapDelta bad_res{5, 0, 0.2, {}};
-  EXPECT_EQ(mirror.apply(bad_res), MapMirror::DeltaResult::kRejected);
-  MapDelta bad_key{5, 0, 0.1, {{{kMaxKeyMagnitude, 0, 0}, VoxelState::kFree}}};
-  EXPECT_EQ(mirror.apply(bad_key), MapMirror::DeltaResult::kRejected);
-  MapDelta bad_state{5, 0, 0.1, {{{0, 0, 0}, static_cast<VoxelState>(9)}}};
-  EXPECT_EQ(mirror.apply(bad_state), MapMirror::DeltaResult::kRejected);
+  map::MapDelta bad_res{5, 0, 0.2, {}};
+  EXPECT_EQ(mirror.apply(bad_res), map::MapMirror::DeltaResult::kRejected);
+  map::MapDelta bad_key{5, 0, 0.1, {{{map::kMaxKeyMagnitude, 0, 0}, map::VoxelState::kFree}}};
+  EXPECT_EQ(mirror.apply(bad_key), map::MapMirror::DeltaResult::kRejected);
+  map::MapDelta bad_state{5, 0, 0.1, {{{0, 0, 0}, static_cast<map::VoxelState>(9)}}};
+  EXPECT_EQ(mirror.apply(bad_state), map::MapMirror::DeltaResult::kRejected);
   EXPECT_EQ(mirror.seq(), 4);
   EXPECT_FALSE(mirror.needs_snapshot());
 }
@@ -182,7 +182,7 @@ TEST(Streaming, MapperRestartMakesMirrorsResynchronise) {
   const auto frames = test::room_frames(6, cam, 6);
   const std::string path = test::temp_path("restart.map");
   auto first = std::make_unique<Mapper>(MapperConfig{});
-  MapMirror mirror(0.1);
+  map::MapMirror mirror(0.1);
   for (int i = 0; i < 4; ++i) {
     mirror.apply(first->integrate(DepthFrame::view(cam, frames[i].pose, frames[i].depth)).delta);
     if (i == 1) first->save_checkpoint(path, 0);  // checkpoint at seq 2, then two more frames
@@ -195,16 +195,16 @@ TEST(Streaming, MapperRestartMakesMirrorsResynchronise) {
   second.load_checkpoint(path);
   EXPECT_EQ(second.seq(), 2 + Mapper::kRestoreSequenceJump);
   const FrameResult r = second.integrate(DepthFrame::view(cam, frames[4].pose, frames[4].depth));
-  EXPECT_EQ(mirror.apply(r.delta), MapMirror::DeltaResult::kBuffered);
+  EXPECT_EQ(mirror.apply(r.delta), map::MapMirror::DeltaResult::kBuffered);
   EXPECT_TRUE(mirror.needs_snapshot());
-  EXPECT_EQ(mirror.apply(second.snapshot()), MapMirror::SnapshotResult::kApplied);
+  EXPECT_EQ(mirror.apply(second.snapshot()), map::MapMirror::SnapshotResult::kApplied);
   expect_same(mirror.grid(), second.map().grid());
 
   // A mapper restarted without a checkpoint begins again at seq 1: also a resync.
   Mapper fresh{MapperConfig{}};
   const FrameResult f1 = fresh.integrate(DepthFrame::view(cam, frames[5].pose, frames[5].depth));
-  EXPECT_EQ(mirror.apply(f1.delta), MapMirror::DeltaResult::kBuffered);
-  EXPECT_EQ(mirror.apply(fresh.snapshot()), MapMirror::SnapshotResult::kApplied);
+  EXPECT_EQ(mirror.apply(f1.delta), map::MapMirror::DeltaResult::kBuffered);
+  EXPECT_EQ(mirror.apply(fresh.snapshot()), map::MapMirror::SnapshotResult::kApplied);
   expect_same(mirror.grid(), fresh.map().grid());
   std::remove(path.c_str());
 }
@@ -213,8 +213,8 @@ TEST(Streaming, StatsCountVolumesAndFrontiers) {
   const runtime::PinholeCamera cam = test::small_camera();
   Mapper mapper{MapperConfig{}};
   for (const auto& f : test::room_frames(3, cam, 3)) mapper.integrate(DepthFrame::view(cam, f.pose, f.depth));
-  const MapStats s = mapper.stats();
-  const StateGrid& g = mapper.map().grid();
+  const map::MapStats s = mapper.stats();
+  const map::StateGrid& g = mapper.map().grid();
   EXPECT_EQ(s.seq, 3);
   EXPECT_EQ(s.free_voxels, g.free_voxels());
   EXPECT_NEAR(s.free_m3, g.free_voxels() * 1e-3, 1e-9);
@@ -229,10 +229,10 @@ TEST(Streaming, StatsCountVolumesAndFrontiers) {
   EXPECT_EQ(mapper.stats(false).frontier_voxels, -1);
   // Free and occupied counts agree with a full scan.
   int64_t free = 0, occ = 0;
-  g.for_each_block([&](const VoxelKey&, const VoxelBlock& b) {
-    for (VoxelState st : b.state) {
-      free += st == VoxelState::kFree;
-      occ += st == VoxelState::kOccupied;
+  g.for_each_block([&](const map::VoxelKey&, const map::VoxelBlock& b) {
+    for (map::VoxelState st : b.state) {
+      free += st == map::VoxelState::kFree;
+      occ += st == map::VoxelState::kOccupied;
     }
   });
   EXPECT_EQ(free, s.free_voxels);

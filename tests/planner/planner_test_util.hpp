@@ -3,27 +3,27 @@
 
 #include <Eigen/Core>
 
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/planner/synthetic_world.hpp"
+#include "semx/fixtures/synthetic_world.hpp"
 
 namespace semx::planner {
 
 // Sets every voxel of the inclusive key box to s.
-inline void fill(mapper::StateGrid& g, const mapper::VoxelKey& lo, const mapper::VoxelKey& hi,
-                 mapper::VoxelState s) {
+inline void fill(map::StateGrid& g, const map::VoxelKey& lo, const map::VoxelKey& hi,
+                 map::VoxelState s) {
   for (int32_t z = lo.z; z <= hi.z; ++z)
     for (int32_t y = lo.y; y <= hi.y; ++y)
       for (int32_t x = lo.x; x <= hi.x; ++x) g.set_state({x, y, z}, s);
 }
 
 // Sets the voxels whose centres lie in the box [lo, hi] (metres) to s.
-inline void fill_m(mapper::StateGrid& g, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                   mapper::VoxelState s) {
-  const mapper::KeyMath& km = g.keys();
+inline void fill_m(map::StateGrid& g, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                   map::VoxelState s) {
+  const map::KeyMath& km = g.keys();
   const double r = km.resolution();
-  const mapper::VoxelKey a = km.key(lo + Eigen::Vector3d::Constant(0.5 * r - 1e-9));
-  const mapper::VoxelKey b = km.key(hi - Eigen::Vector3d::Constant(0.5 * r - 1e-9));
+  const map::VoxelKey a = km.key(lo + Eigen::Vector3d::Constant(0.5 * r - 1e-9));
+  const map::VoxelKey b = km.key(hi - Eigen::Vector3d::Constant(0.5 * r - 1e-9));
   fill(g, a, b, s);
 }
 

@@ -11,8 +11,8 @@
 namespace semx::planner {
 namespace {
 
-using mapper::VoxelKey;
-using mapper::VoxelState;
+using map::VoxelKey;
+using map::VoxelState;
 
 // A short-range sensor and dense rays, so every voxel of the sector is reached.
 GainConfig dense_config() {
@@ -25,8 +25,8 @@ GainConfig dense_config() {
 }
 
 // Free space around the origin's voxel (keys -25..24 on every axis), everything else unknown.
-mapper::StateGrid free_scene() {
-  mapper::StateGrid g(0.1);
+map::StateGrid free_scene() {
+  map::StateGrid g(0.1);
   fill(g, {-25, -25, -25}, {24, 24, 24}, VoxelState::kFree);
   return g;
 }
@@ -35,12 +35,12 @@ const Eigen::Vector3d kNode(0.05, 0.05, 0.05);  // centre of voxel (0, 0, 0)
 
 // A 3x3x3 cube of unknown voxels centred on c: 26 frontier voxels (a face on free space) and a
 // "normal" unknown one in the middle.
-void unknown_cube(mapper::StateGrid& g, const VoxelKey& c) {
+void unknown_cube(map::StateGrid& g, const VoxelKey& c) {
   fill(g, {c.x - 1, c.y - 1, c.z - 1}, {c.x + 1, c.y + 1, c.z + 1}, VoxelState::kUnknown);
 }
 
 TEST(Gain, CountsEachVoxelKindWithItsWeight) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   unknown_cube(g, {15, -5, 0});
   // A surface voxel: unknown, a free neighbour (toward the node) and an occupied one behind it.
   g.set_state({15, 5, 0}, VoxelState::kUnknown);
@@ -64,7 +64,7 @@ TEST(Gain, CountsEachVoxelKindWithItsWeight) {
 // Ignored voxels (the unobservable ones) count for nothing, whichever block they are in: the ray
 // walk reads them from the block masks, the exhaustive reference from the set.
 TEST(Gain, IgnoredVoxelsCountForNothing) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   // Cubes straddling block boundaries (blocks are 16 voxels: keys -1|0 and 15|16) and in
   // negative blocks.
   unknown_cube(g, {15, 0, 0});
@@ -95,7 +95,7 @@ TEST(Gain, IgnoredVoxelsCountForNothing) {
 }
 
 TEST(Gain, WeightsAreConfigurable) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   unknown_cube(g, {15, 0, 0});
   GainConfig c = dense_config();
   c.weight_unknown = 10;
@@ -106,7 +106,7 @@ TEST(Gain, WeightsAreConfigurable) {
 }
 
 TEST(Gain, OccupiedVoxelsOccludeUnknownOnesDoNot) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   unknown_cube(g, {15, -5, 0});
   g.set_state({15, 5, 0}, VoxelState::kUnknown);
   g.set_state({16, 5, 0}, VoxelState::kOccupied);
@@ -127,7 +127,7 @@ TEST(Gain, OccupiedVoxelsOccludeUnknownOnesDoNot) {
 }
 
 TEST(Gain, RangeAndVerticalFieldOfView) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   GainConfig c = dense_config();
   GainEvaluator e(c);
   g.set_state({1, 0, 0}, VoxelState::kUnknown);    // 0.1 m: below min_range
@@ -142,7 +142,7 @@ TEST(Gain, RangeAndVerticalFieldOfView) {
 }
 
 TEST(Gain, YawBinsPickTheRichestWindow) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   unknown_cube(g, {15, 0, 0});  // +x: 53 weighted
   unknown_cube(g, {0, 15, 0});  // +y: two cubes side by side, 106
   unknown_cube(g, {-4, 15, 0});
@@ -208,7 +208,7 @@ TEST(Gain, BinOfAzimuthAgreesWithAtan2) {
 }
 
 TEST(Gain, AViewpointInsideAnObstacleSeesNothing) {
-  mapper::StateGrid g = free_scene();
+  map::StateGrid g = free_scene();
   unknown_cube(g, {15, 0, 0});
   g.set_state({0, 0, 0}, VoxelState::kOccupied);
   GainEvaluator e(dense_config());
@@ -219,7 +219,7 @@ TEST(Gain, AViewpointInsideAnObstacleSeesNothing) {
 TEST(Gain, DefaultRaysSampleWhatTheReferenceCounts) {
   // A half-explored room: the planner's sensor range and ray density.
   SyntheticWorld w = SyntheticWorld::two_rooms();
-  mapper::StateGrid g(0.1);
+  map::StateGrid g(0.1);
   w.observe(g, w.start(), 0.0, runtime::PinholeCamera{}, 2);
   GainEvaluator e(GainConfig{});
   const Eigen::Vector3d p = w.start() + Eigen::Vector3d(1.0, 0.3, 0.0);

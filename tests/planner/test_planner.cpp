@@ -10,13 +10,13 @@
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/exploration_planner.hpp"
-#include "semx/planner/exploration_sim.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
 #include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
 namespace {
 
-using mapper::VoxelState;
+using map::VoxelState;
 
 VehiclePose pose(const Eigen::Vector3d& p, double yaw = 0.0, int64_t utime = 0) {
   VehiclePose v;
@@ -40,15 +40,15 @@ std::optional<PlannedPath> first_path(ExplorationPlanner& p, int64_t from, int64
 }
 
 // A 10 x 4 x 2.5 m corridor whose first 6 m are known: the frontier is the plane x = 6.1.
-mapper::StateGrid corridor() {
-  mapper::StateGrid g(0.1);
+map::StateGrid corridor() {
+  map::StateGrid g(0.1);
   SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2})
       .reveal(g, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.0, 4.2, 2.7)});
   return g;
 }
 
 TEST(Planner, PicksTheGoalFacingTheKnownFrontier) {
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   ExplorationPlanner p(test_config("dep"));
   p.set_map(&g);
   p.set_pose(pose({1, 2, 1.2}, 0.5 * core::kPi));
@@ -70,7 +70,7 @@ TEST(Planner, PicksTheGoalFacingTheKnownFrontier) {
 // Two nodes mirrored about x = 6 in a corridor with unknown space at both ends: equal gains.
 struct MirrorScene {
   PlannerConfig config = test_config("semantic-dep");
-  mapper::StateGrid grid = mapper::StateGrid(0.1);
+  map::StateGrid grid = map::StateGrid(0.1);
   FrontierTracker frontiers{1.0};
   core::SplitMixRng rng{1};
   std::vector<SemanticRegion> regions;
@@ -199,7 +199,7 @@ TEST(Planner, UnexploredWeightScalesARegionByTheGainAroundIt) {
 
   // Mapped all round: the nearest node sees nothing unknown, and the reward is the paper's.
   MirrorScene known;
-  known.grid = mapper::StateGrid(0.1);
+  known.grid = map::StateGrid(0.1);
   SyntheticWorld::room({12, 4, 2.5}, {6, 2, 1.2})
       .reveal(known.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(12.2, 4.2, 2.7)});
   known.frontiers.reset(known.grid);
@@ -252,7 +252,7 @@ TEST(Planner, PassageWeightScalesADoorByTheGainAroundItEvenOnceObserved) {
 
 TEST(Planner, DeclaresDoneOnAFullyKnownMap) {
   const SyntheticWorld w = SyntheticWorld::two_rooms();
-  mapper::StateGrid g = w.full_map();
+  map::StateGrid g = w.full_map();
   PlannerConfig c = test_config();
   ExplorationPlanner p(c);
   p.set_map(&g);
@@ -274,7 +274,7 @@ TEST(Planner, DeclaresDoneOnAFullyKnownMap) {
 }
 
 TEST(Planner, ReportsInitUntilItHasMapAndPose) {
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   ExplorationPlanner p(test_config());
   auto out = p.tick(0);
   ASSERT_TRUE(out.status);
@@ -288,7 +288,7 @@ TEST(Planner, ReportsInitUntilItHasMapAndPose) {
 }
 
 TEST(Planner, PlanningTimeIsChargedBeforeThePathGoesOut) {
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   PlannerConfig c = test_config();
   c.charge.base_s = 0.2;
   ExplorationPlanner p(c);
@@ -323,7 +323,7 @@ TEST(Planner, PlanningTimeIsChargedBeforeThePathGoesOut) {
 }
 
 TEST(Planner, NoCycleIsChargedLessThanMinAndTheTwoStepTickAgrees) {
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   PlannerConfig c = test_config();
   c.charge.min_s = 2.0;  // far more than this cycle's work
   ExplorationPlanner p(c);
@@ -362,7 +362,7 @@ TEST(Planner, NoCycleIsChargedLessThanMinAndTheTwoStepTickAgrees) {
 
 // The planner on the corridor map with the vehicle at (1, 2, 1.2), after its first path (at t).
 struct CorridorStart {
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   ExplorationPlanner p{test_config()};
   int64_t t = 0;
   std::optional<PlannedPath> first;
@@ -411,7 +411,7 @@ TEST(Planner, AGoalReachedStartsACycleOnceTheDwellIsOverNotAtTheNextSlot) {
   PlannerConfig c = test_config();
   c.charge.scale = 0.0;
   ExplorationPlanner p(c);
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   p.set_map(&g);
   p.set_pose(pose({1, 2, 1.2}));
   int64_t t = 0;
@@ -437,10 +437,10 @@ TEST(Planner, ReplansWhenThePathIsBlocked) {
   ASSERT_GE(first->waypoints.size(), 2u);
   // An obstacle appears on the last segment of the path.
   const Eigen::Vector3d mid = 0.5 * (first->waypoints[first->waypoints.size() - 2] + first->waypoints.back());
-  std::vector<mapper::VoxelChange> changes;
-  const mapper::VoxelKey k = g.keys().key(mid);
+  std::vector<map::VoxelChange> changes;
+  const map::VoxelKey k = g.keys().key(mid);
   for (int dz = -1; dz <= 1; ++dz) {
-    const mapper::VoxelKey q{k.x, k.y, k.z + dz};
+    const map::VoxelKey q{k.x, k.y, k.z + dz};
     g.set_state(q, VoxelState::kOccupied);
     changes.push_back({q, VoxelState::kOccupied});
   }
@@ -457,7 +457,7 @@ TEST(Planner, ReplansWhenThePathIsBlocked) {
 // Checks every released path against the map it was planned on: waypoints keep the clearance,
 // segments are collision-free (the first, from the vehicle, by the root rule).
 struct PathAudit {
-  const mapper::StateGrid* grid = nullptr;
+  const map::StateGrid* grid = nullptr;
   CollisionChecker checker{CollisionConfig{}};
   int paths = 0;
   int bad = 0;
@@ -486,7 +486,7 @@ TEST(Planner, AepFallbackGrowsTowardFarFrontiers) {
   // The corridor's frontier (x = 6.1) is beyond what AEP's local tree (0.5 m box around x = 1)
   // can see with a 2 m sensor: no local gain, nothing cached; the fallback must sample around the
   // frontier and fly there rather than declare the map done.
-  mapper::StateGrid g = corridor();
+  map::StateGrid g = corridor();
   PlannerConfig c = test_config("aep");
   c.aep.radius = 0.5;
   c.gain.max_range = 2.0;

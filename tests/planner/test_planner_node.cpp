@@ -7,11 +7,11 @@
 #include <optional>
 #include <vector>
 
-#include "messages.hpp"  // the mapper's conversions (MAP_SNAPSHOT)
+#include "map_messages.hpp"
 #include "planner_messages.hpp"
 #include "planner_node.hpp"
 #include "planner_test_util.hpp"
-#include "semx/mapper/map_snapshot.hpp"
+#include "semx/map/map_snapshot.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::planner {
@@ -55,8 +55,8 @@ struct Harness {
                                         [this](const semx::planner_status_t& m) { statuses.push_back(m); });
   }
   runtime::Node& node() { return planner->node(); }
-  void send_map(const mapper::StateGrid& g, int64_t seq = 1) {
-    node().publish(ch::MAP_SNAPSHOT, mapper::to_message(mapper::encode_snapshot(g, seq, 0)));
+  void send_map(const map::StateGrid& g, int64_t seq = 1) {
+    node().publish(ch::MAP_SNAPSHOT, map::to_message(map::encode_snapshot(g, seq, 0)));
     node().drain();
   }
   void send_pose(const Eigen::Vector3d& p, double yaw = 0.0) {
@@ -79,8 +79,8 @@ struct Harness {
   }
 };
 
-mapper::StateGrid corridor() {
-  mapper::StateGrid g(0.1);
+map::StateGrid corridor() {
+  map::StateGrid g(0.1);
   SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2})
       .reveal(g, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.0, 4.2, 2.7)});
   return g;
@@ -92,7 +92,7 @@ TEST(PlannerNode, PlansOnTheMapItReceivesAndPublishesEverything) {
   ASSERT_FALSE(h.statuses.empty());  // INIT: waiting
   EXPECT_EQ(h.statuses.back().state, semx::planner_status_t::INIT);
   EXPECT_TRUE(h.paths.empty());
-  const mapper::StateGrid g = corridor();
+  const map::StateGrid g = corridor();
   h.send_map(g);
   ASSERT_TRUE(h.planner->map().in_sync());
   h.send_pose({1, 2, 1.2});

@@ -18,7 +18,7 @@
 namespace semx::planner {
 namespace {
 
-using mapper::VoxelState;
+using map::VoxelState;
 
 TEST(Roadmap, NodesEdgesAndNeighbours) {
   Roadmap g(1.0);
@@ -67,10 +67,10 @@ TEST(Roadmap, ShortestPaths) {
 }
 
 // A 6 x 4 x 2.5 m room, known entirely (walls occupied).
-mapper::StateGrid known_room() { return SyntheticWorld::room({6, 4, 2.5}, {1, 2, 1.2}).full_map(); }
+map::StateGrid known_room() { return SyntheticWorld::room({6, 4, 2.5}, {1, 2, 1.2}).full_map(); }
 
 TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
-  mapper::StateGrid g = known_room();
+  map::StateGrid g = known_room();
   CollisionChecker c(CollisionConfig{});
   c.set_grid(&g);
   EXPECT_TRUE(c.node_free({3, 2, 1.2}));
@@ -85,7 +85,7 @@ TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
   EXPECT_TRUE(c.node_free({3, 1.4, 1.2}));
   // Diagonal: a voxel 0.45 m away along each axis is 0.64 m away: the ball does not reach it but
   // the body box (0.35 m) does not either.
-  mapper::StateGrid h = known_room();
+  map::StateGrid h = known_room();
   c.set_grid(&h);
   h.set_state(h.keys().key(Eigen::Vector3d(3.45, 2.45, 1.25)), VoxelState::kOccupied);
   EXPECT_TRUE(c.node_free({3.0, 2.0, 1.2}));
@@ -96,12 +96,12 @@ TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
 // obstacle over a cluttered map with unknown voxels and blocks never allocated, for both unknown
 // rules, and again after local changes reported through note_changes.
 TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
-  mapper::StateGrid g(0.1);
+  map::StateGrid g(0.1);
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> coord(0, 29), state(0, 9);
   fill(g, {0, 0, 0}, {29, 29, 19}, VoxelState::kFree);
   for (int i = 0; i < 120; ++i) {
-    const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
+    const map::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
     g.set_state(k, state(rng) < 6 ? VoxelState::kOccupied : VoxelState::kUnknown);
   }
   CollisionChecker c(CollisionConfig{});
@@ -114,7 +114,7 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
     const Eigen::Vector3d fl = u.array().floor();
     for (int corner = 0; corner < 8; ++corner) {
       double w = 1.0;
-      mapper::VoxelKey k;
+      map::VoxelKey k;
       for (int i = 0; i < 3; ++i) {
         const int bit = (corner >> i) & 1;
         const double f = u[i] - fl[i];
@@ -125,7 +125,7 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
       for (int32_t z = k.z - 12; z <= k.z + 12; ++z)
         for (int32_t y = k.y - 12; y <= k.y + 12; ++y)
           for (int32_t x = k.x - 12; x <= k.x + 12; ++x) {
-            const VoxelState s = g.state(mapper::VoxelKey{x, y, z});
+            const VoxelState s = g.state(map::VoxelKey{x, y, z});
             if (s == VoxelState::kFree || (s == VoxelState::kUnknown && !unknown)) continue;
             const int64_t dx = x - k.x, dy = y - k.y, dz = z - k.z;
             best = std::min(best, dx * dx + dy * dy + dz * dz);
@@ -151,9 +151,9 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
     // Clear a few obstacles, add others, turn some unknown; tell the checker, after the first
     // round with each change's previous state (the cache of a rule the change does not concern
     // is kept, and must still be exact).
-    std::vector<mapper::VoxelChange> changes;
+    std::vector<map::VoxelChange> changes;
     for (int i = 0; i < 30; ++i) {
-      const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
+      const map::VoxelKey k{coord(rng), coord(rng), coord(rng) % 20};
       const VoxelState after = static_cast<VoxelState>(i % 3);
       const VoxelState before = g.state(k);
       if (before == after) continue;
@@ -169,25 +169,25 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
 // map, and around a single voxel where only the box's corners reach it. Each check is counted
 // (box, then the ESDF when the box is free): the planning-time charge is made of these counts.
 TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
-  mapper::StateGrid g(0.1);
+  map::StateGrid g(0.1);
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> coord(0, 39), state(0, 9);
   fill(g, {0, 0, 0}, {39, 39, 24}, VoxelState::kFree);
   for (int i = 0; i < 60; ++i) {
-    const mapper::VoxelKey k{coord(rng), coord(rng), coord(rng) % 25};
+    const map::VoxelKey k{coord(rng), coord(rng), coord(rng) % 25};
     g.set_state(k, state(rng) < 6 ? VoxelState::kOccupied : VoxelState::kUnknown);
   }
   const CollisionConfig config;
   CollisionChecker c(config);
   c.set_grid(&g);
-  auto box_free_in = [](const mapper::StateGrid& m, const Eigen::Vector3d& p, const Eigen::Vector3d& half) {
+  auto box_free_in = [](const map::StateGrid& m, const Eigen::Vector3d& p, const Eigen::Vector3d& half) {
     const double r = m.resolution();
     const Eigen::Vector3i lo_key = ((p - half) / r).array().floor().cast<int>() - 1,
                           hi_key = ((p + half) / r).array().floor().cast<int>() + 1;
     for (int32_t z = lo_key.z(); z <= hi_key.z(); ++z)
       for (int32_t y = lo_key.y(); y <= hi_key.y(); ++y)
         for (int32_t x = lo_key.x(); x <= hi_key.x(); ++x) {
-          if (m.state(mapper::VoxelKey{x, y, z}) == VoxelState::kFree) continue;
+          if (m.state(map::VoxelKey{x, y, z}) == VoxelState::kFree) continue;
           const Eigen::Vector3d lo(x * r, y * r, z * r), hi = lo + Eigen::Vector3d::Constant(r);
           if (((lo - (p + half)).array() < 0).all() && ((hi - (p - half)).array() > 0).all()) return false;
         }
@@ -219,9 +219,9 @@ TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
   EXPECT_LT(free_nodes, 550);
   EXPECT_GT(blocked_by_box, 0);
   // Where the shortcut's bound is tight: one voxel near a corner of the box, in every direction.
-  mapper::StateGrid one(0.1);
+  map::StateGrid one(0.1);
   fill(one, {0, 0, 0}, {39, 39, 24}, VoxelState::kFree);
-  one.set_state(mapper::VoxelKey{20, 20, 12}, VoxelState::kOccupied);
+  one.set_state(map::VoxelKey{20, 20, 12}, VoxelState::kOccupied);
   c.set_grid(&one);
   const Eigen::Vector3d voxel(2.05, 2.05, 1.25);
   std::normal_distribution<double> normal;
@@ -240,7 +240,7 @@ TEST(Collision, NodeChecksAreTheBoxAndClearanceDefinition) {
 }
 
 TEST(Collision, EdgesKeepTheClearanceAllAlong) {
-  mapper::StateGrid g = known_room();
+  map::StateGrid g = known_room();
   CollisionChecker c(CollisionConfig{});
   c.set_grid(&g);
   EXPECT_TRUE(c.edge_free({1, 1, 1.2}, {5, 3, 1.2}));
@@ -264,7 +264,7 @@ TEST(Collision, EdgesKeepTheClearanceAllAlong) {
     }
   }
   // Into unknown space: blocked.
-  mapper::StateGrid h = known_room();
+  map::StateGrid h = known_room();
   fill_m(h, {4, 0, 0}, {6, 4, 2.5}, VoxelState::kUnknown);
   c.set_grid(&h);
   EXPECT_FALSE(c.edge_free({1, 2, 1.2}, {3.75, 2, 1.2}));  // its end 0.25 m from unknown space
@@ -273,7 +273,7 @@ TEST(Collision, EdgesKeepTheClearanceAllAlong) {
 }
 
 TEST(Collision, RootEdgesMayLeaveUnmappedSurroundings) {
-  mapper::StateGrid g = known_room();
+  map::StateGrid g = known_room();
   // The vehicle at (1, 2, 1.2) never saw the voxels right above and below it (up to 0.2 m below:
   // an edge may pass 0.3 m from unknown voxels for door_length in a doorway).
   fill_m(g, {0.6, 1.6, 0.5}, {1.4, 2.4, 1.0}, VoxelState::kUnknown);
@@ -292,7 +292,7 @@ TEST(Collision, ARootWhoseBoxCornerTouchesAVoxelMayMoveAwayFromIt) {
   // A door leaf's edge (one occupied column) overlapping the corner of the bare vehicle box at the
   // root, 0.3 m away in the ESDF: the vehicle braked there (env3, dep, seed 4) and had no edge
   // to any node, DONE at 39 %. It may leave without coming closer, not pass the edge.
-  mapper::StateGrid g = known_room();
+  map::StateGrid g = known_room();
   fill_m(g, {3.2, 2.2, 0.0}, {3.3, 2.3, 2.5}, VoxelState::kOccupied);
   CollisionChecker c(CollisionConfig{});
   c.set_grid(&g);
@@ -308,7 +308,7 @@ TEST(Collision, ARootWhoseBoxCornerTouchesAVoxelMayMoveAwayFromIt) {
 // DEP's roadmap over cycles on a partly known map.
 struct DepFixture {
   PlannerConfig config = test_config("dep");
-  mapper::StateGrid grid = mapper::StateGrid(0.1);
+  map::StateGrid grid = map::StateGrid(0.1);
   FrontierTracker frontiers{1.0};
   core::SplitMixRng rng{7};
   std::vector<SemanticRegion> regions;
@@ -329,7 +329,7 @@ struct DepFixture {
 };
 
 // The 10 x 4 m corridor, its first 6 m known (walls included), the rest unknown.
-void corridor(mapper::StateGrid& g) {
+void corridor(map::StateGrid& g) {
   const SyntheticWorld w = SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2});
   w.reveal(g, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.0, 4.2, 2.7)});
 }
@@ -377,7 +377,7 @@ TEST(DepRoadmap, NodesAndEdgesAreCollisionFreeAndPersistAcrossCycles) {
 // clearance, and the candidates drawn between the unreachable room and the reachable one.
 // An 8 x 8 x 2.5 m room, known entirely, split at y = 4 by a wall with a doorway whose free voxel
 // centres span x0..x1 (up to 2.05 m high).
-void two_rooms_with_doorway(mapper::StateGrid& g, double x0, double x1) {
+void two_rooms_with_doorway(map::StateGrid& g, double x0, double x1) {
   fill_m(g, {-0.05, -0.05, -0.05}, {8.05, 8.05, 2.55}, VoxelState::kOccupied);
   fill_m(g, {0.05, 0.05, 0.05}, {7.95, 7.95, 2.45}, VoxelState::kFree);
   fill_m(g, {0.05, 3.95, 0.05}, {7.95, 4.05, 2.45}, VoxelState::kOccupied);  // the wall
@@ -530,11 +530,11 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
 }
 
 // Sets a wall across the corridor at x = 3 occupied; returns its changes (free -> occupied).
-std::vector<mapper::VoxelChange> wall_across_corridor(mapper::StateGrid& g) {
-  std::vector<mapper::VoxelChange> changes;
+std::vector<map::VoxelChange> wall_across_corridor(map::StateGrid& g) {
+  std::vector<map::VoxelChange> changes;
   for (double y = 0.05; y < 4; y += 0.1) {
     for (double z = 0.05; z < 2.5; z += 0.1) {
-      const mapper::VoxelKey k = g.keys().key(Eigen::Vector3d(3.05, y, z));
+      const map::VoxelKey k = g.keys().key(Eigen::Vector3d(3.05, y, z));
       g.set_state(k, VoxelState::kOccupied);
       changes.push_back({k, VoxelState::kOccupied, VoxelState::kFree});
     }
@@ -580,9 +580,9 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   dep.on_map_reset();
   PlanContext ctx = f.context({1, 2, 1.2});
   dep.plan(ctx);
-  const std::vector<mapper::VoxelChange> wall = wall_across_corridor(f.grid);
-  std::vector<mapper::VoxelChange> cleared;
-  for (const mapper::VoxelChange& c : wall)
+  const std::vector<map::VoxelChange> wall = wall_across_corridor(f.grid);
+  std::vector<map::VoxelChange> cleared;
+  for (const map::VoxelChange& c : wall)
     cleared.push_back({c.key, VoxelState::kFree, VoxelState::kOccupied});
   dep.on_map_changes(wall);
   PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
@@ -600,7 +600,7 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   ASSERT_GT(far, 3);
   ASSERT_EQ(cut_reached, 0);
 
-  for (const mapper::VoxelChange& c : cleared) f.grid.set_state(c.key, VoxelState::kFree);
+  for (const map::VoxelChange& c : cleared) f.grid.set_state(c.key, VoxelState::kFree);
   dep.on_map_changes(cleared);
   PlanContext ctx3 = f.context({1, 2, 1.2}, 0.0, 3);
   dep.process_map_changes(ctx3);
@@ -708,7 +708,7 @@ TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   // Evaluate everything, then change one voxel far beyond every node's range.
   for (const RoadmapNode& n : dep.graph().slots())
     if (n.alive && (n.gain_stale || !n.gain.valid)) dep.evaluate_gain(ctx, n.id);
-  const mapper::VoxelKey far = f.grid.keys().key(Eigen::Vector3d(30, 2, 1));
+  const map::VoxelKey far = f.grid.keys().key(Eigen::Vector3d(30, 2, 1));
   f.grid.set_state(far, VoxelState::kFree);
   dep.on_map_changes({{far, VoxelState::kFree}});
   PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
@@ -718,7 +718,7 @@ TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
       EXPECT_FALSE(n.gain_stale);
     }
   // A change next to them does.
-  const mapper::VoxelKey near = f.grid.keys().key(Eigen::Vector3d(6.5, 2, 1));
+  const map::VoxelKey near = f.grid.keys().key(Eigen::Vector3d(6.5, 2, 1));
   f.grid.set_state(near, VoxelState::kFree);
   dep.on_map_changes({{near, VoxelState::kFree}});
   dep.process_map_changes(ctx2);

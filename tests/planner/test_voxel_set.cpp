@@ -9,7 +9,7 @@
 namespace semx::planner {
 namespace {
 
-using mapper::VoxelKey;
+using map::VoxelKey;
 
 TEST(VoxelSet, AgreesWithAHashSet) {
   std::mt19937 rng(3);
@@ -33,12 +33,12 @@ TEST(VoxelSet, AgreesWithAHashSet) {
 TEST(VoxelSet, BlockMasksHoldTheirBlocksMembersOnly) {
   VoxelSet s;
   s.insert({-1, 0, 0});                  // block (-1, 0, 0)
-  s.insert({mapper::kBlockSize, 0, 0});  // block (1, 0, 0)
+  s.insert({map::kBlockSize, 0, 0});  // block (1, 0, 0)
   EXPECT_EQ(s.block_mask({0, 0, 0}), nullptr);
   const VoxelSet::Mask* m = s.block_mask({-1, 0, 0});
   ASSERT_NE(m, nullptr);
-  EXPECT_TRUE(VoxelSet::test(*m, mapper::local_index({-1, 0, 0})));
-  EXPECT_FALSE(VoxelSet::test(*m, mapper::local_index({-2, 0, 0})));
+  EXPECT_TRUE(VoxelSet::test(*m, map::local_index({-1, 0, 0})));
+  EXPECT_FALSE(VoxelSet::test(*m, map::local_index({-2, 0, 0})));
   ASSERT_NE(s.block_mask({1, 0, 0}), nullptr);
   EXPECT_TRUE(VoxelSet::test(*s.block_mask({1, 0, 0}), 0));
   EXPECT_FALSE(s.insert({-1, 0, 0}));

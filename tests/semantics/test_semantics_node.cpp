@@ -5,7 +5,7 @@
 #include <limits>
 #include <semx/clock_t.hpp>
 
-#include "frame_messages.hpp"
+#include "simulator_messages.hpp"
 #include "semantics_messages.hpp"
 #include "semantics_node.hpp"
 #include "semantics_test_util.hpp"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "frame_messages.hpp"
+#include "simulator_messages.hpp"
 #include "semx/runtime/channels.hpp"
 #include "simulator_node.hpp"
 #include "test_util.hpp"

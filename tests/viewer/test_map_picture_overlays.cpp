@@ -21,7 +21,7 @@ MapView area(double x1, double y1) {
 }
 
 TEST(MapPictureOverlays, PixelsPerColumnOverridesTheFit) {
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   MapPictureOptions o;
   o.max_side_px = 100;
   o.pixels_per_column = 7;
@@ -35,7 +35,7 @@ TEST(MapPictureOverlays, PixelsPerColumnOverridesTheFit) {
 }
 
 TEST(MapPictureOverlays, AnArrowPointsFromItsStart) {
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   MapPictureOptions o;
   o.pixels_per_column = 10;
   MapPicture pic(grid, area(4, 4), o);
@@ -59,8 +59,8 @@ TEST(MapPictureOverlays, AnArrowPointsFromItsStart) {
 }
 
 TEST(MapPictureOverlays, NonFiniteAndFarOverlaysAreSkippedOrClipped) {
-  mapper::StateGrid grid(0.1);
-  grid.set_state({5, 5, 10}, mapper::VoxelState::kFree);
+  map::StateGrid grid(0.1);
+  grid.set_state({5, 5, 10}, map::VoxelState::kFree);
   MapPictureOptions o;
   o.pixels_per_column = 5;
   MapPicture pic(grid, area(3, 3), o);

@@ -34,14 +34,14 @@ bool near_pixel(const Image& img, Eigen::Vector2i p, Rgb c, int tol, int r = 1) 
 
 // A 6 x 4 m area at 0.1 m: free everywhere in the band at y < 2 m, an occupied column at
 // (4.55, 3.55), unknown elsewhere.
-mapper::StateGrid hand_map() {
-  mapper::StateGrid g(0.1);
+map::StateGrid hand_map() {
+  map::StateGrid g(0.1);
   for (int x = 0; x < 60; ++x) {
-    for (int y = 0; y < 20; ++y) g.set_state({x, y, 10}, mapper::VoxelState::kFree);
+    for (int y = 0; y < 20; ++y) g.set_state({x, y, 10}, map::VoxelState::kFree);
   }
-  g.set_state({45, 35, 10}, mapper::VoxelState::kFree);
-  g.set_state({45, 35, 11}, mapper::VoxelState::kOccupied);
-  g.set_state({45, 35, 40}, mapper::VoxelState::kOccupied);  // above the band: not drawn
+  g.set_state({45, 35, 10}, map::VoxelState::kFree);
+  g.set_state({45, 35, 11}, map::VoxelState::kOccupied);
+  g.set_state({45, 35, 40}, map::VoxelState::kOccupied);  // above the band: not drawn
   return g;
 }
 
@@ -65,7 +65,7 @@ Roadmap three_nodes() {
 }
 
 TEST(TopDownView, DrawsEachLayerInItsColourAtItsPlace) {
-  const mapper::StateGrid grid = hand_map();
+  const map::StateGrid grid = hand_map();
   TopDownView view(fixed_options());
   view.set_time(12500000);
   // Trail west to east along y = 3.5, then the vehicle stops at (2, 3) facing +x.
@@ -142,7 +142,7 @@ TEST(TopDownView, DrawsTheControllersTrajectoryAlongItsCurve) {
   line.control_points.resize(3);
   EXPECT_TRUE(sample_curve(line).empty()) << "too few control points for a cubic";
 
-  const mapper::StateGrid grid = hand_map();
+  const map::StateGrid grid = hand_map();
   TopDownView view(fixed_options());
   TrajectoryCurve c;
   c.knot_interval = 0.25;
@@ -276,9 +276,9 @@ TEST(TopDownView, DropsNaNFarAndTooManyInputs) {
 
 TEST(TopDownView, FarItemsCannotBlowUpThePicture) {
   TopDownView view;
-  mapper::StateGrid grid(0.1);
-  grid.set_state({0, 0, 10}, mapper::VoxelState::kFree);
-  grid.set_state({90000, -90000, 10}, mapper::VoxelState::kOccupied);  // 9 km away
+  map::StateGrid grid(0.1);
+  grid.set_state({0, 0, 10}, map::VoxelState::kFree);
+  grid.set_state({90000, -90000, 10}, map::VoxelState::kOccupied);  // 9 km away
   ASSERT_TRUE(view.add_pose(0, {1, 1, 1}, kIdentity));
   RoadmapNode far;
   far.position = {9999, -9999, 1};
@@ -327,7 +327,7 @@ solids:
                                                         "box.yaml");
   TopDownView view;
   view.set_world(world);
-  mapper::StateGrid grid(0.1);
+  map::StateGrid grid(0.1);
   const evaluator::MapPicture pic = view.picture(&grid);
   EXPECT_GT(pic.count(evaluator::MapPicture::Column::kUnmappedWall), 20);
   const Image img = pic.render();

@@ -22,7 +22,7 @@
 #include <map>
 #include <sstream>
 
-#include "messages.hpp"
+#include "map_messages.hpp"
 #include "semx/runtime/channels.hpp"
 #include "viewer_node.hpp"
 
@@ -134,16 +134,16 @@ std::vector<Event> scene(bool clock, int ticks = 31) {
       out.push_back(event(ch::SIM_CLOCK, c));
     }
     if (k % 2 == 0) {
-      mapper::MapDelta d;
+      map::MapDelta d;
       d.seq = ++seq;
       d.utime = t;
       d.resolution = 0.1;
       const int kx = static_cast<int>(std::floor(x / 0.1));
       for (int ix = kx - 3; ix <= kx + 3; ++ix) {
-        for (int iy = 5; iy <= 15; ++iy) d.changes.push_back({{ix, iy, 10}, mapper::VoxelState::kFree});
+        for (int iy = 5; iy <= 15; ++iy) d.changes.push_back({{ix, iy, 10}, map::VoxelState::kFree});
       }
-      d.changes.push_back({{kx, 17, 10}, mapper::VoxelState::kOccupied});
-      out.push_back(event(ch::MAP_UPDATE, mapper::to_message(d)));
+      d.changes.push_back({{kx, 17, 10}, map::VoxelState::kOccupied});
+      out.push_back(event(ch::MAP_UPDATE, map::to_message(d)));
     }
     if (t == 1000000) {
       out.push_back(event(ch::ROADMAP, roadmap(t, 5)));

@@ -28,8 +28,8 @@ double wall_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-mapper::MapClientOptions client_options(const runtime::Node& node) {
-  mapper::MapClientOptions o;
+map::MapClientOptions client_options(const runtime::Node& node) {
+  map::MapClientOptions o;
   o.resolution = 0;  // adopt the mapper's; the ground truth follows it
   o.requester = node.name();
   return o;
@@ -44,7 +44,7 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
       options_(std::move(options)),
       evaluation_(std::move(world), options_.evaluation),
       map_(node_, client_options(node_)) {
-  map_.on_delta([this](const mapper::MapDelta& d) {
+  map_.on_delta([this](const map::MapDelta& d) {
     note_wall();
     evaluation_.on_map_delta(d, map_.mirror().grid());
     message_time(d.utime);
@@ -208,8 +208,8 @@ void EvaluatorNode::write_folder() {
   try {
     const RunSummary s = evaluation_.summary();
     written_ = write_run_metrics(options_.out_dir, s);
-    const mapper::StateGrid empty(evaluation_.tracker().resolution());
-    const mapper::StateGrid& grid = map_.has_mirror() ? map_.mirror().grid() : empty;
+    const map::StateGrid empty(evaluation_.tracker().resolution());
+    const map::StateGrid& grid = map_.has_mirror() ? map_.mirror().grid() : empty;
     const std::string title = (s.info.world.empty() ? std::string("map") : s.info.world) +
                               (s.info.planner.empty() ? "" : ", " + s.info.planner) + "  coverage " +
                               std::to_string(static_cast<int>(std::floor(s.coverage_pct))) +

@@ -46,7 +46,7 @@ class EvaluatorNode {
 
   bool finished() const { return evaluation_.finished(); }
   const Evaluation& evaluation() const { return evaluation_; }
-  const mapper::MapClient& map() const { return map_; }
+  const map::MapClient& map() const { return map_; }
   const std::vector<std::string>& written() const { return written_; }
   bool write_failed() const { return write_failed_; }
 
@@ -64,7 +64,7 @@ class EvaluatorNode {
   runtime::Node& node_;
   EvaluatorNodeOptions options_;
   Evaluation evaluation_;
-  mapper::MapClient map_;
+  map::MapClient map_;
   double wall_start_ = -1;
   double wall_end_ = -1;
   double next_progress_s_ = 0;

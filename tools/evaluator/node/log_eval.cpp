@@ -12,7 +12,7 @@
 #include <filesystem>
 #include <limits>
 
-#include "messages.hpp"
+#include "map_messages.hpp"
 #include "semx/evaluator/map_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
 #include "semx/runtime/channels.hpp"
@@ -27,8 +27,8 @@ namespace fs = std::filesystem;
 struct LogEvaluator::Held {
   bool snapshot = false;
   int64_t utime = 0;
-  mapper::MapDelta delta;
-  mapper::MapSnapshot snap;
+  map::MapDelta delta;
+  map::MapSnapshot snap;
 };
 
 namespace {
@@ -76,7 +76,7 @@ std::string world_stem(const std::string& path) { return fs::path(path).stem().s
 
 }  // namespace
 
-std::string world_named_in_log(const std::string& log_path, const mapper::LogLayout& layout) {
+std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout) {
   lcm::LogFile log(log_path, "r");
   if (!log.good()) return "";
   std::string why;
@@ -92,8 +92,8 @@ std::string world_named_in_log(const std::string& log_path, const mapper::LogLay
 
 LogEvaluator::LogEvaluator(LogEvalOptions options) : options_(std::move(options)) {
   try {
-    report_.layout = mapper::scan_log(options_.log_path);
-  } catch (const mapper::ReplayError& e) {
+    report_.layout = runtime::scan_log(options_.log_path);
+  } catch (const runtime::LogError& e) {
     throw LogEvalError(e.what());
   }
   std::string world = options_.world;
@@ -111,28 +111,28 @@ LogEvaluator::LogEvaluator(LogEvalOptions options) : options_(std::move(options)
   if (eo.info.world_path.empty()) eo.info.world_path = world_path_;
   eo.info.source = "log";
   evaluation_ = std::make_unique<Evaluation>(std::move(w), std::move(eo));
-  empty_ = std::make_unique<mapper::StateGrid>(evaluation_->tracker().resolution());
+  empty_ = std::make_unique<map::StateGrid>(evaluation_->tracker().resolution());
 }
 
 LogEvaluator::~LogEvaluator() = default;
 LogEvaluator::LogEvaluator(LogEvaluator&&) noexcept = default;
 LogEvaluator& LogEvaluator::operator=(LogEvaluator&&) noexcept = default;
 
-const mapper::StateGrid& LogEvaluator::grid() const { return mirror_ ? mirror_->grid() : *empty_; }
+const map::StateGrid& LogEvaluator::grid() const { return mirror_ ? mirror_->grid() : *empty_; }
 
 void LogEvaluator::apply(const Held& h) {
   if (evaluation_->finished()) return;
   if (h.snapshot) {
     if (mirror_ && !same_resolution(h.snap.resolution, mirror_->resolution())) mirror_.reset();
-    if (!mirror_) mirror_ = std::make_unique<mapper::MapMirror>(h.snap.resolution);
-    if (mirror_->apply(h.snap) == mapper::MapMirror::SnapshotResult::kApplied) {
+    if (!mirror_) mirror_ = std::make_unique<map::MapMirror>(h.snap.resolution);
+    if (mirror_->apply(h.snap) == map::MapMirror::SnapshotResult::kApplied) {
       evaluation_->on_map_reset(mirror_->grid(), h.utime, mirror_->seq());
     }
     return;
   }
-  if (!mirror_) mirror_ = std::make_unique<mapper::MapMirror>(h.delta.resolution);
+  if (!mirror_) mirror_ = std::make_unique<map::MapMirror>(h.delta.resolution);
   const int64_t gaps = mirror_->counters().gaps;
-  if (mirror_->apply(h.delta) == mapper::MapMirror::DeltaResult::kApplied) {
+  if (mirror_->apply(h.delta) == map::MapMirror::DeltaResult::kApplied) {
     evaluation_->on_map_delta(h.delta, mirror_->grid());
   }
   report_.map_gaps += mirror_->counters().gaps - gaps;
@@ -207,8 +207,8 @@ void LogEvaluator::run() {
     } else if (c == ch::MAP_UPDATE) {
       Held h;
       semx::map_update_t update{};
-      if (!decode_event(*e, update, why) || !mapper::accept_update(update) ||
-          !mapper::from_message(update, h.delta)) {
+      if (!decode_event(*e, update, why) || !map::accept_update(update) ||
+          !map::from_message(update, h.delta)) {
         bad(i, c, why.empty() ? "content rejected" : why);
         continue;
       }
@@ -222,13 +222,13 @@ void LogEvaluator::run() {
     } else if (c == ch::MAP_SNAPSHOT) {
       Held h;
       semx::map_snapshot_t snapshot{};
-      if (!decode_event(*e, snapshot, why) || !mapper::accept_snapshot(snapshot)) {
+      if (!decode_event(*e, snapshot, why) || !map::accept_snapshot(snapshot)) {
         bad(i, c, why.empty() ? "content rejected" : why);
         continue;
       }
       h.snapshot = true;
       h.utime = snapshot.utime;
-      h.snap = mapper::from_message(snapshot);
+      h.snap = map::from_message(snapshot);
       if (report_.clock) {
         held_.push_back(std::move(h));
       } else {

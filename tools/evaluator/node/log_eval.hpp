@@ -4,7 +4,7 @@
 // rule for map messages (held until the SIM_CLOCK tick after their utime, as the lockstep
 // evaluator's MapClient holds them), so a lockstep run and its log give the same figures.
 //
-// The log is scanned first (mapper::scan_log: LCM 1.3.1's reader asserts on corrupt headers);
+// The log is scanned first (runtime::scan_log: LCM 1.3.1's reader asserts on corrupt headers);
 // only the complete events are read. Every event goes through the same wire validation and
 // decoding as a live subscription; malformed ones are counted and skipped.
 #pragma once
@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "map_replay.hpp"
+#include "semx/runtime/log_scan.hpp"
 #include "semx/evaluator/evaluation.hpp"
-#include "semx/mapper/map_mirror.hpp"
+#include "semx/map/map_mirror.hpp"
 
 namespace semx::evaluator {
 
@@ -34,7 +34,7 @@ struct LogEvalOptions {
 };
 
 struct LogEvalReport {
-  mapper::LogLayout layout;
+  runtime::LogLayout layout;
   std::map<std::string, int64_t> channels;  // events read, per channel
   int64_t events_read = 0;
   int64_t malformed = 0;  // events on a semx channel that failed validation or decoding
@@ -59,7 +59,7 @@ class LogEvaluator {
   const Evaluation& evaluation() const { return *evaluation_; }
   const LogEvalReport& report() const { return report_; }
   // The map rebuilt from the log (an empty map before any map message).
-  const mapper::StateGrid& grid() const;
+  const map::StateGrid& grid() const;
   const std::string& world_path() const { return world_path_; }
 
   // Writes the run folder: the metrics files and map.png. Returns the paths written.
@@ -74,14 +74,14 @@ class LogEvaluator {
   LogEvalOptions options_;
   std::string world_path_;
   std::unique_ptr<Evaluation> evaluation_;
-  std::unique_ptr<mapper::MapMirror> mirror_;
-  std::unique_ptr<mapper::StateGrid> empty_;
+  std::unique_ptr<map::MapMirror> mirror_;
+  std::unique_ptr<map::StateGrid> empty_;
   std::vector<Held> held_;
   LogEvalReport report_;
   bool ran_ = false;
 };
 
 // The world a log names: the description of its first SIM_EVENT EPISODE_START ("" if none).
-std::string world_named_in_log(const std::string& log_path, const mapper::LogLayout& layout);
+std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout);
 
 }  // namespace semx::evaluator

@@ -8,7 +8,7 @@ namespace semx::evaluator {
 
 namespace {
 
-Eigen::Vector3i to_eigen(const mapper::VoxelKey& k) { return {k.x, k.y, k.z}; }
+Eigen::Vector3i to_eigen(const map::VoxelKey& k) { return {k.x, k.y, k.z}; }
 
 }  // namespace
 
@@ -54,33 +54,33 @@ double CoverageTracker::coverage() const {
   return t > 0 ? static_cast<double>(covered_) / static_cast<double>(t) : 0.0;
 }
 
-void CoverageTracker::set(const mapper::VoxelKey& key, mapper::VoxelState state) {
+void CoverageTracker::set(const map::VoxelKey& key, map::VoxelState state) {
   const Eigen::Vector3i k = to_eigen(key);
   if (!gt_->in_grid(k)) return;
   const size_t i = gt_->index(k);
   if (!gt_->target()[i]) return;
-  const uint8_t now = state != mapper::VoxelState::kUnknown;
+  const uint8_t now = state != map::VoxelState::kUnknown;
   if (known_[i] == now) return;
   known_[i] = now;
   covered_ += now ? 1 : -1;
   if (object_[i]) object_covered_ += now ? 1 : -1;
 }
 
-bool CoverageTracker::apply(const mapper::MapDelta& delta) {
+bool CoverageTracker::apply(const map::MapDelta& delta) {
   if (!matches(delta.resolution)) return false;
   for (const auto& c : delta.changes) set(c.key, c.state);
   return true;
 }
 
-bool CoverageTracker::reset(const mapper::StateGrid& grid) {
+bool CoverageTracker::reset(const map::StateGrid& grid) {
   clear();
   if (!matches(grid.resolution())) return false;
   // Only blocks with known voxels can cover anything; a map is far smaller than the world's grid
   // early on and about its size at the end, so this is at most one pass over the map.
-  grid.for_each_block([&](const mapper::VoxelKey& bk, const mapper::VoxelBlock& b) {
+  grid.for_each_block([&](const map::VoxelKey& bk, const map::VoxelBlock& b) {
     if (b.known == 0) return;
-    for (int i = 0; i < mapper::kBlockVolume; ++i) {
-      if (b.state[i] != mapper::VoxelState::kUnknown) set(mapper::voxel_of(bk, i), b.state[i]);
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      if (b.state[i] != map::VoxelState::kUnknown) set(map::voxel_of(bk, i), b.state[i]);
     }
   });
   return true;
@@ -92,12 +92,12 @@ void CoverageTracker::clear() {
   object_covered_ = 0;
 }
 
-bool CoverageTracker::known(const mapper::VoxelKey& key) const {
+bool CoverageTracker::known(const map::VoxelKey& key) const {
   const Eigen::Vector3i k = to_eigen(key);
   return gt_->in_grid(k) && known_[gt_->index(k)];
 }
 
-int64_t CoverageTracker::count_covered(const simulator::GroundTruth& gt, const mapper::StateGrid& grid) {
+int64_t CoverageTracker::count_covered(const simulator::GroundTruth& gt, const map::StateGrid& grid) {
   int64_t n = 0;
   auto reader = grid.reader();
   const Eigen::Vector3i& lo = gt.min_key();
@@ -107,7 +107,7 @@ int64_t CoverageTracker::count_covered(const simulator::GroundTruth& gt, const m
       for (int x = 0; x < d.x(); ++x) {
         const Eigen::Vector3i k(lo.x() + x, lo.y() + y, lo.z() + z);
         if (!gt.in_target(k)) continue;
-        n += reader.state(mapper::VoxelKey(k.x(), k.y(), k.z())) != mapper::VoxelState::kUnknown;
+        n += reader.state(map::VoxelKey(k.x(), k.y(), k.z())) != map::VoxelState::kUnknown;
       }
     }
   }

@@ -37,7 +37,7 @@ void Evaluation::note_coverage(int64_t utime) {
   metrics_.on_object_coverage(utime, tracker_->object_covered(), tracker_->object_target_count());
 }
 
-void Evaluation::on_map_delta(const mapper::MapDelta& delta, const mapper::StateGrid& grid_after) {
+void Evaluation::on_map_delta(const map::MapDelta& delta, const map::StateGrid& grid_after) {
   if (finished()) return;
   ++map_deltas_;
   map_seq_ = delta.seq;
@@ -49,7 +49,7 @@ void Evaluation::on_map_delta(const mapper::MapDelta& delta, const mapper::State
   note_coverage(delta.utime);
 }
 
-void Evaluation::on_map_reset(const mapper::StateGrid& grid, int64_t utime, int64_t seq) {
+void Evaluation::on_map_reset(const map::StateGrid& grid, int64_t utime, int64_t seq) {
   if (finished()) return;
   ++map_resets_;
   if (seq >= 0) map_seq_ = seq;

@@ -26,7 +26,7 @@ MapView MapView::of_world(const simulator::World& world) {
   return v;
 }
 
-MapPicture::MapPicture(const mapper::StateGrid& grid, const MapView& view, MapPictureOptions options)
+MapPicture::MapPicture(const map::StateGrid& grid, const MapView& view, MapPictureOptions options)
     : view_(view), options_(std::move(options)), res_(grid.resolution()) {
   const double inv = 1.0 / res_;
   kx0_ = static_cast<int32_t>(std::floor(view_.lo.x() * inv + kEps));
@@ -45,12 +45,12 @@ MapPicture::MapPicture(const mapper::StateGrid& grid, const MapView& view, MapPi
     for (int ix = 0; ix < nx_; ++ix) {
       Column c = Column::kUnknown;
       for (int32_t kz = kz0_; kz <= kz1_; ++kz) {
-        const mapper::VoxelState s = reader.state({kx0_ + ix, ky0_ + iy, kz});
-        if (s == mapper::VoxelState::kOccupied) {
+        const map::VoxelState s = reader.state({kx0_ + ix, ky0_ + iy, kz});
+        if (s == map::VoxelState::kOccupied) {
           c = Column::kOccupied;
           break;
         }
-        if (s == mapper::VoxelState::kFree) c = Column::kFree;
+        if (s == map::VoxelState::kFree) c = Column::kFree;
       }
       cells_[static_cast<size_t>(iy) * nx_ + ix] = c;
     }
@@ -226,7 +226,7 @@ Image MapPicture::render() const {
 
 void MapPicture::write_png(const std::string& path) const { evaluator::write_png(render(), path); }
 
-MapPicture run_map_picture(const mapper::StateGrid& grid, const simulator::World& world,
+MapPicture run_map_picture(const map::StateGrid& grid, const simulator::World& world,
                            const simulator::GroundTruth* gt, const std::vector<Eigen::Vector3d>& trajectory,
                            const std::string& title, const std::function<void(MapPicture&)>& beneath) {
   MapPictureOptions o;

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "semx/mapper/voxel_key.hpp"
+#include "semx/map/voxel_key.hpp"
 
 namespace semx::evaluator {
 
@@ -49,25 +49,25 @@ void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions)
   }
 }
 
-int64_t write_octomap_bt(const mapper::StateGrid& grid, const std::string& path) {
+int64_t write_octomap_bt(const map::StateGrid& grid, const std::string& path) {
   octomap::OcTree tree(grid.resolution());
   const float occupied = static_cast<float>(tree.getClampingThresMaxLog());
   const float free = static_cast<float>(tree.getClampingThresMinLog());
   int64_t written = 0;
-  for (const mapper::VoxelKey& bk : grid.sorted_block_keys()) {
-    const mapper::VoxelBlock* b = grid.find_block(bk);
+  for (const map::VoxelKey& bk : grid.sorted_block_keys()) {
+    const map::VoxelBlock* b = grid.find_block(bk);
     if (!b) continue;
-    for (int i = 0; i < mapper::kBlockVolume; ++i) {
-      const mapper::VoxelState s = b->state[i];
-      if (s == mapper::VoxelState::kUnknown) continue;
-      const mapper::VoxelKey k = mapper::voxel_of(bk, i);
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      const map::VoxelState s = b->state[i];
+      if (s == map::VoxelState::kUnknown) continue;
+      const map::VoxelKey k = map::voxel_of(bk, i);
       if (k.x < -kOctoOffset || k.x >= kOctoOffset || k.y < -kOctoOffset || k.y >= kOctoOffset ||
           k.z < -kOctoOffset || k.z >= kOctoOffset)
         continue;
       const octomap::OcTreeKey ok(static_cast<uint16_t>(k.x + kOctoOffset),
                                   static_cast<uint16_t>(k.y + kOctoOffset),
                                   static_cast<uint16_t>(k.z + kOctoOffset));
-      tree.setNodeValue(ok, s == mapper::VoxelState::kOccupied ? occupied : free, /*lazy_eval=*/true);
+      tree.setNodeValue(ok, s == map::VoxelState::kOccupied ? occupied : free, /*lazy_eval=*/true);
       ++written;
     }
   }

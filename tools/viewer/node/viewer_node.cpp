@@ -23,8 +23,8 @@ namespace ch = semx::channels;
 
 namespace {
 
-mapper::MapClientOptions client_options(const runtime::Node& node) {
-  mapper::MapClientOptions o;
+map::MapClientOptions client_options(const runtime::Node& node) {
+  map::MapClientOptions o;
   o.resolution = 0;  // adopt the mapper's
   o.requester = node.name();
   o.quiet = true;
@@ -95,7 +95,7 @@ ViewerNode::ViewerNode(runtime::Node& node, ViewerNodeOptions options)
                                       [this](const semx::map_update_t& m) { message_time(m.utime); });
   node_.subscribe<semx::map_snapshot_t>(ch::MAP_SNAPSHOT,
                                         [this](const semx::map_snapshot_t& m) { message_time(m.utime); });
-  map_ = std::make_unique<mapper::MapClient>(node_, client_options(node_));
+  map_ = std::make_unique<map::MapClient>(node_, client_options(node_));
 
   node_.subscribe<semx::odometry_t>(ch::ODOMETRY, [this](const semx::odometry_t& m) {
     message_time(m.utime);
@@ -164,7 +164,7 @@ void ViewerNode::maybe_draw(int64_t utime) {
 }
 
 void ViewerNode::draw_frame(int64_t index) {
-  const mapper::StateGrid* grid = map_->has_mirror() ? &map_->mirror().grid() : nullptr;
+  const map::StateGrid* grid = map_->has_mirror() ? &map_->mirror().grid() : nullptr;
   const evaluator::Image img = view_.render(grid);
   ++frames_;
   if (!options_.out_dir.empty()) {

@@ -56,7 +56,7 @@ class ViewerNode {
   const std::string& last_file() const { return last_file_; }
   int64_t now_utime() const { return time_; }
   const TopDownView& view() const { return view_; }
-  const mapper::MapClient& map() const { return *map_; }
+  const map::MapClient& map() const { return *map_; }
 
  private:
   // The time of a message (without a clock): draws the frame it makes due, then moves the time.
@@ -68,7 +68,7 @@ class ViewerNode {
   ViewerNodeOptions options_;
   TopDownView view_;
   FrameSchedule schedule_;
-  std::unique_ptr<mapper::MapClient> map_;
+  std::unique_ptr<map::MapClient> map_;
   int64_t time_ = -1;
   int64_t last_tick_ = -1;
   int64_t frames_ = 0;

@@ -200,7 +200,7 @@ void TopDownView::clear_run() {
   planner_ = PlannerInfo{};
 }
 
-std::string TopDownView::header(const mapper::StateGrid* grid) const {
+std::string TopDownView::header(const map::StateGrid* grid) const {
   double known_m3 = 0;
   if (grid) {
     const double r = grid->resolution();
@@ -229,7 +229,7 @@ void TopDownView::include(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) 
   area_hi_ = area_hi_.cwiseMax(hi);
 }
 
-evaluator::MapView TopDownView::update_view(const mapper::StateGrid* grid) {
+evaluator::MapView TopDownView::update_view(const map::StateGrid* grid) {
   const double res = grid ? grid->resolution() : empty_grid_.resolution();
   evaluator::MapView v;
   if (world_) v = evaluator::MapView::of_world(*world_);
@@ -337,8 +337,8 @@ std::vector<double> TopDownView::normalized_scores() const {
   return t;
 }
 
-evaluator::MapPicture TopDownView::picture(const mapper::StateGrid* grid) {
-  const mapper::StateGrid& g = grid ? *grid : empty_grid_;
+evaluator::MapPicture TopDownView::picture(const map::StateGrid* grid) {
+  const map::StateGrid& g = grid ? *grid : empty_grid_;
   const double res = g.resolution();
   const evaluator::MapView v = update_view(grid);
 

@@ -8,6 +8,7 @@
 // seeded through mix_seed); changing either engine changes every figure of every run.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -46,6 +47,8 @@ class SplitMix64 {
 class Xoshiro256StarStar {
  public:
   explicit Xoshiro256StarStar(uint64_t seed = 1) { reseed(seed); }
+  // From the four words themselves (the reference implementation's test vectors).
+  explicit Xoshiro256StarStar(const std::array<uint64_t, 4>& state) : s_{state[0], state[1], state[2], state[3]} {}
   void reseed(uint64_t seed) {
     uint64_t x = seed;
     for (auto& s : s_) {

@@ -18,9 +18,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "semx/mapper/esdf_grid.hpp"
+#include "semx/map/esdf_grid.hpp"
 #include "semx/mapper/mapper_config.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 
 namespace semx::mapper {
 
@@ -31,9 +31,9 @@ class EsdfBuilder {
   // Recomputes the field over the window centred on `center` when the window moved, `changed`
   // (voxels whose state changed since the last call) intersects it, or `force`. Returns whether
   // it recomputed.
-  bool update(const StateGrid& grid, const Eigen::Vector3d& center, const KeyBox& changed, int64_t map_seq,
+  bool update(const map::StateGrid& grid, const Eigen::Vector3d& center, const map::KeyBox& changed, int64_t map_seq,
               bool force = false);
-  const EsdfGrid& grid() const { return grid_; }
+  const map::EsdfGrid& grid() const { return grid_; }
   const EsdfParams& params() const { return params_; }
   // Whether the last computation found the inside distances with the full transform (too many
   // voxels deep inside obstacles for the search); for tests and benchmarks.
@@ -43,17 +43,17 @@ class EsdfBuilder {
   static constexpr double kDefaultSearchBudget = 8.0;
   void set_inside_search_budget(double visits_per_voxel) { search_budget_ = visits_per_voxel; }
   // Window placement for a vehicle at `center` (exposed for tests and the node).
-  VoxelKey window_origin(const Eigen::Vector3d& center) const;
+  map::VoxelKey window_origin(const Eigen::Vector3d& center) const;
 
  private:
-  void compute(const StateGrid& grid);
+  void compute(const map::StateGrid& grid);
   // neg_ = squared distance to the nearest non-obstacle voxel, for the obstacle voxels only.
   void inside_distances();
   // The same for every voxel by the full transform (sites: the non-obstacle voxels).
   void inside_transform();
 
   EsdfParams params_;
-  EsdfGrid grid_;
+  map::EsdfGrid grid_;
   std::vector<uint8_t> obstacle_;
   std::vector<float> pos_, neg_;
   std::vector<float> line_in_, line_out_, env_z_;

@@ -24,6 +24,6 @@ std::unique_ptr<octomap::OcTree> to_octree(const OccupancyMap& map, ExportReport
 ExportReport export_octomap_bt(const OccupancyMap& map, const std::string& path);
 // Centres of the occupied voxels as a PCD v0.7 point cloud (fields x y z, float32), binary or
 // ASCII. Throws MapIoError naming the file.
-ExportReport export_occupied_pcd(const StateGrid& grid, const std::string& path, bool binary = true);
+ExportReport export_occupied_pcd(const map::StateGrid& grid, const std::string& path, bool binary = true);
 
 }  // namespace semx::mapper

@@ -17,9 +17,9 @@
 #include "semx/mapper/checkpoint.hpp"
 #include "semx/mapper/depth_integrator.hpp"
 #include "semx/mapper/esdf_builder.hpp"
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/map_snapshot.hpp"
-#include "semx/mapper/map_stats.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/map_snapshot.hpp"
+#include "semx/map/map_stats.hpp"
 #include "semx/mapper/mapper_config.hpp"
 #include "semx/mapper/occupancy_map.hpp"
 
@@ -27,7 +27,7 @@ namespace semx::mapper {
 
 struct FrameResult {
   IntegrationReport report;
-  MapDelta delta;  // meaningful when report.accepted; publish it even when it has no changes
+  map::MapDelta delta;  // meaningful when report.accepted; publish it even when it has no changes
   double integrate_ms = 0.0;
 };
 
@@ -51,12 +51,12 @@ class Mapper {
   // Brings the ESDF window (centred on `center`, usually the vehicle) up to date with the map.
   // Returns whether it recomputed; false also when the ESDF is disabled.
   bool update_esdf(const Eigen::Vector3d& center, bool force = false);
-  const EsdfGrid& esdf() const { return esdf_.grid(); }
+  const map::EsdfGrid& esdf() const { return esdf_.grid(); }
   double esdf_ms() const { return esdf_ms_; }
 
-  MapSnapshot snapshot(int64_t utime = 0) const { return encode_snapshot(map_.grid(), seq_, utime); }
+  map::MapSnapshot snapshot(int64_t utime = 0) const { return map::encode_snapshot(map_.grid(), seq_, utime); }
   // count_frontiers visits the whole map (a few ms for a house); MAP_STATS at 1 Hz can afford it.
-  MapStats stats(bool count_frontiers = true) const;
+  map::MapStats stats(bool count_frontiers = true) const;
 
   CheckpointInfo save_checkpoint(const std::string& path, int64_t utime) const;
   // Replaces the map with the checkpoint's (throws MapIoError, leaving the map as it was).
@@ -73,7 +73,7 @@ class Mapper {
   DepthIntegrator integrator_;
   EsdfBuilder esdf_;
   int64_t seq_ = 0;
-  KeyBox esdf_dirty_;        // voxels changed since the last ESDF update
+  map::KeyBox esdf_dirty_;        // voxels changed since the last ESDF update
   bool esdf_stale_ = false;  // the whole map was replaced
   double esdf_ms_ = 0.0;
   double last_integrate_ms_ = 0.0;

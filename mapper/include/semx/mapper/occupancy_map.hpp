@@ -1,4 +1,4 @@
-// The mapper's log-odds occupancy map: a StateGrid whose blocks also carry log-odds.
+// The mapper's log-odds occupancy map: a map::StateGrid whose blocks also carry log-odds.
 //
 // Update rule (OctoMap's): l <- clamp(l + l_hit) for a voxel an observation ends in, l <- clamp(l +
 // l_miss) for a voxel a ray passes through, with l starting at 0 for a never-observed voxel, in
@@ -11,7 +11,7 @@
 #include <optional>
 
 #include "semx/mapper/mapper_config.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 
 namespace semx::mapper {
 
@@ -24,41 +24,41 @@ class OccupancyMap {
 
   const OccupancyParams& params() const { return params_; }
   double resolution() const { return grid_.resolution(); }
-  const KeyMath& keys() const { return grid_.keys(); }
-  const StateGrid& grid() const { return grid_; }
+  const map::KeyMath& keys() const { return grid_.keys(); }
+  const map::StateGrid& grid() const { return grid_; }
 
   float hit_log_odds() const { return l_hit_; }
   float miss_log_odds() const { return l_miss_; }
   float min_log_odds() const { return l_min_; }
   float max_log_odds() const { return l_max_; }
   float threshold_log_odds() const { return l_occ_; }
-  VoxelState classify(float log_odds) const {
-    return log_odds >= l_occ_ ? VoxelState::kOccupied : VoxelState::kFree;
+  map::VoxelState classify(float log_odds) const {
+    return log_odds >= l_occ_ ? map::VoxelState::kOccupied : map::VoxelState::kFree;
   }
 
   // Whether updates may touch voxel k (always true without configured bounds).
-  bool in_bounds(const VoxelKey& k) const { return !bounded_ || bounds_.contains(k); }
+  bool in_bounds(const map::VoxelKey& k) const { return !bounded_ || bounds_.contains(k); }
   // The updatable key box; empty optional when unbounded.
-  std::optional<KeyBox> bounds() const { return bounded_ ? std::optional<KeyBox>(bounds_) : std::nullopt; }
+  std::optional<map::KeyBox> bounds() const { return bounded_ ? std::optional<map::KeyBox>(bounds_) : std::nullopt; }
 
-  VoxelState state(const VoxelKey& k) const { return grid_.state(k); }
-  VoxelState state(const Eigen::Vector3d& p) const { return grid_.state(p); }
+  map::VoxelState state(const map::VoxelKey& k) const { return grid_.state(k); }
+  map::VoxelState state(const Eigen::Vector3d& p) const { return grid_.state(p); }
   // Log-odds of a known voxel; nullopt for unknown ones.
-  std::optional<float> log_odds(const VoxelKey& k) const;
+  std::optional<float> log_odds(const map::VoxelKey& k) const;
 
   // One observation of one voxel (integration applies at most one per voxel per frame). Returns
   // the new state; *changed tells whether the state changed. Out-of-bounds voxels are ignored.
-  VoxelState update(const VoxelKey& k, bool hit, bool* changed = nullptr);
+  map::VoxelState update(const map::VoxelKey& k, bool hit, bool* changed = nullptr);
   // Sets a voxel's log-odds (clamped into [min, max]); NaN makes the voxel unknown again.
   // For restoring checkpoints and building test scenes.
-  void set_log_odds(const VoxelKey& k, float log_odds);
+  void set_log_odds(const map::VoxelKey& k, float log_odds);
   // The same for a whole block: values[i] for local index i (NaN = unknown).
-  void set_block_log_odds(const VoxelKey& block_key, const float* values);
+  void set_block_log_odds(const map::VoxelKey& block_key, const float* values);
   void clear() { grid_.clear(); }
 
   // Batch path for the integrator: applies one observation to voxel i of block b and returns
   // the state before and after.
-  void apply(VoxelBlock& b, const VoxelKey& k, int i, bool hit, VoxelState& before, VoxelState& after) {
+  void apply(map::VoxelBlock& b, const map::VoxelKey& k, int i, bool hit, map::VoxelState& before, map::VoxelState& after) {
     before = b.state[i];
     float l = b.log_odds[i] + (hit ? l_hit_ : l_miss_);
     if (l < l_min_) l = l_min_;
@@ -70,11 +70,11 @@ class OccupancyMap {
       grid_.note_transition(b, k, before, after);
     }
   }
-  VoxelBlock& block(const VoxelKey& block_key) { return grid_.get_or_create_block(block_key); }
+  map::VoxelBlock& block(const map::VoxelKey& block_key) { return grid_.get_or_create_block(block_key); }
 
-  // ---- the shared queries (see StateGrid) ----
-  bool is_frontier(const VoxelKey& k) const { return grid_.is_frontier(k); }
-  bool is_surface(const VoxelKey& k) const { return grid_.is_surface(k); }
+  // ---- the shared queries (see map::StateGrid) ----
+  bool is_frontier(const map::VoxelKey& k) const { return grid_.is_frontier(k); }
+  bool is_surface(const map::VoxelKey& k) const { return grid_.is_surface(k); }
   bool is_visible(const Eigen::Vector3d& from, const Eigen::Vector3d& to, bool unknown_blocks = false) const {
     return grid_.is_visible(from, to, unknown_blocks);
   }
@@ -86,10 +86,10 @@ class OccupancyMap {
 
  private:
   OccupancyParams params_;
-  StateGrid grid_;
+  map::StateGrid grid_;
   float l_hit_, l_miss_, l_min_, l_max_, l_occ_;
   bool bounded_ = false;
-  KeyBox bounds_;
+  map::KeyBox bounds_;
 };
 
 }  // namespace semx::mapper

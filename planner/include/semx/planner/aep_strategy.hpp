@@ -29,9 +29,9 @@ class AepStrategy : public Strategy {
  public:
   explicit AepStrategy(const PlannerConfig& config);
 
-  void on_map_changes(const std::vector<mapper::VoxelChange>& changes) override;
+  void on_map_changes(const std::vector<map::VoxelChange>& changes) override;
   void on_map_reset() override;
-  void on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) override;
+  void on_gain_invalidated(const std::vector<map::VoxelKey>& keys) override;
   PlanOutcome plan(PlanContext& ctx) override;
   std::optional<double> goal_score(PlanContext&, const Goal&) override { return std::nullopt; }
   void reject_goal(const Goal& goal, int64_t until_cycle) override { global_.reject_goal(goal, until_cycle); }
@@ -51,7 +51,7 @@ class AepStrategy : public Strategy {
   GainEvaluator gains_;
   DepStrategy global_;  // the fallback graph (no sampling of its own)
   Roadmap cache_;       // cached gains at positions (no edges)
-  std::set<mapper::VoxelKey> changed_blocks_;
+  std::set<map::VoxelKey> changed_blocks_;
   bool cache_reset_ = false;
   std::vector<TreeNode> tree_;
   int best_ = -1;

@@ -28,8 +28,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
 
 namespace semx::planner {
@@ -38,8 +38,8 @@ class CollisionChecker {
  public:
   explicit CollisionChecker(const CollisionConfig& config);
 
-  void set_grid(const mapper::StateGrid* grid) { grid_ = grid; }
-  const mapper::StateGrid* grid() const { return grid_; }
+  void set_grid(const map::StateGrid* grid) { grid_ = grid; }
+  const map::StateGrid* grid() const { return grid_; }
   // Half sizes of the box that bounds everything node_free() looks at.
   const Eigen::Vector3d& half_extent() const { return reach_; }
 
@@ -74,7 +74,7 @@ class CollisionChecker {
 
   // The grid changed at these voxels and nowhere else since the checker last looked: cached ESDF
   // values near them are dropped, the rest kept (any other change drops the whole cache).
-  void note_changes(const std::vector<mapper::VoxelChange>& changes) const;
+  void note_changes(const std::vector<map::VoxelChange>& changes) const;
 
   // Centre values are cached in chunks of kChunkSize^3 voxels, each filled at once.
   static constexpr int kChunkBits = 3;
@@ -102,15 +102,15 @@ class CollisionChecker {
   Eigen::Vector3d reach_;         // max(body_half_, clearance) per axis
   // The ESDF at one voxel centre (before trilinear interpolation), exact below cache_cap_ +
   // a voxel diagonal + half a voxel and a lower bound above; cached until the grid changes.
-  double centre_value(const mapper::VoxelKey& c, bool unknown_is_obstacle) const;
+  double centre_value(const map::VoxelKey& c, bool unknown_is_obstacle) const;
   using CacheChunk = std::array<double, kChunkVolume>;
-  void fill_chunk(const mapper::VoxelKey& chunk, bool unknown_is_obstacle, CacheChunk& out) const;
+  void fill_chunk(const map::VoxelKey& chunk, bool unknown_is_obstacle, CacheChunk& out) const;
   // The same, uncached, searching `reach` voxels around c.
-  double centre_search(const mapper::VoxelKey& c, int reach, bool unknown_is_obstacle) const;
+  double centre_search(const map::VoxelKey& c, int reach, bool unknown_is_obstacle) const;
   static int reach_for(double cap, double res);
   void validate_cache() const;
 
-  const mapper::StateGrid* grid_ = nullptr;
+  const map::StateGrid* grid_ = nullptr;
   mutable int64_t box_checks_ = 0;
   // Edge points 0.1 m and 0.01 m apart share most of their 8 corner centres, and edges share
   // them with their neighbours: caching the centres' values instead of searching around every
@@ -135,7 +135,7 @@ class CollisionChecker {
     std::vector<int32_t> gx, gy;
   };
   mutable FillScratch fill_scratch_;
-  mutable const mapper::StateGrid* cache_grid_ = nullptr;
+  mutable const map::StateGrid* cache_grid_ = nullptr;
   mutable std::array<uint64_t, 4> cache_stamp_{};
 };
 

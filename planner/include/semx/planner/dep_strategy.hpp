@@ -40,9 +40,9 @@ class DepStrategy : public Strategy {
   // m: while recovering, a passage node may stand this close to other nodes (try_insert).
   static constexpr double kPassageSpacing = 0.15;
 
-  void on_map_changes(const std::vector<mapper::VoxelChange>& changes) override;
+  void on_map_changes(const std::vector<map::VoxelChange>& changes) override;
   void on_map_reset() override;
-  void on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) override;
+  void on_gain_invalidated(const std::vector<map::VoxelKey>& keys) override;
   PlanOutcome plan(PlanContext& ctx) override;
   std::optional<double> goal_score(PlanContext& ctx, const Goal& goal) override;
   void reject_goal(const Goal& goal, int64_t until_cycle) override;
@@ -134,10 +134,10 @@ class DepStrategy : public Strategy {
   Sampler sampler_;
   Roadmap graph_;
   int64_t root_ = -1;
-  std::set<mapper::VoxelKey> changed_blocks_;  // since the last cycle
+  std::set<map::VoxelKey> changed_blocks_;  // since the last cycle
   std::set<int64_t> reapproached_;             // passage nodes given approaches in this recovery
   // Voxels that became occupied or unknown since the last cycle, by block.
-  std::map<mapper::VoxelKey, std::vector<mapper::VoxelKey>> obstacle_voxels_;
+  std::map<map::VoxelKey, std::vector<map::VoxelKey>> obstacle_voxels_;
   bool full_reset_ = false;
   // The last cycle's search and per-slot values, for goal_score() and the roadmap view.
   Roadmap::Search search_;

@@ -30,8 +30,8 @@
 #include <optional>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/gain_evaluator.hpp"
@@ -52,9 +52,9 @@ class ExplorationPlanner {
   PlannerKind kind() const { return kind_; }
 
   // The map to plan on; must stay valid until replaced. A different grid counts as a reset.
-  void set_map(const mapper::StateGrid* grid);
+  void set_map(const map::StateGrid* grid);
   // After the grid applied a delta (`changes` are its voxels and new states).
-  void on_map_changes(const std::vector<mapper::VoxelChange>& changes);
+  void on_map_changes(const std::vector<map::VoxelChange>& changes);
   // After the grid's content was replaced (a snapshot).
   void on_map_reset();
   void set_pose(const VehiclePose& pose);
@@ -89,7 +89,7 @@ class ExplorationPlanner {
   const FrontierTracker& frontiers() const { return frontiers_; }
   const VoxelSet& unobservable() const { return unobservable_; }
   // Voxels no gain should count from now on (known to be unobservable by other means).
-  void add_unobservable(const std::vector<mapper::VoxelKey>& keys);
+  void add_unobservable(const std::vector<map::VoxelKey>& keys);
   Strategy& strategy() { return *strategy_; }
   const std::vector<SemanticRegion>& regions() const { return regions_; }
 
@@ -128,7 +128,7 @@ class ExplorationPlanner {
   int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
   int64_t short_since_ = -1;    // since when the controller holds away from the goal
   core::SplitMixRng rng_;
-  const mapper::StateGrid* grid_ = nullptr;
+  const map::StateGrid* grid_ = nullptr;
   std::optional<VehiclePose> pose_;
   std::vector<SemanticRegion> regions_;
 

@@ -13,8 +13,8 @@
 #include <unordered_set>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 
 namespace semx::planner {
 
@@ -22,15 +22,15 @@ class FrontierTracker {
  public:
   explicit FrontierTracker(double cluster_size = 1.0);
 
-  void reset(const mapper::StateGrid& grid);
-  void update(const mapper::StateGrid& grid, const std::vector<mapper::VoxelChange>& changes);
+  void reset(const map::StateGrid& grid);
+  void update(const map::StateGrid& grid, const std::vector<map::VoxelChange>& changes);
   void clear();
 
   size_t size() const { return frontier_.size(); }
-  bool contains(const mapper::VoxelKey& k) const { return frontier_.count(k) != 0; }
+  bool contains(const map::VoxelKey& k) const { return frontier_.count(k) != 0; }
 
   struct Cluster {
-    mapper::VoxelKey cell;   // cell coordinates (floor(voxel centre / cluster_size))
+    map::VoxelKey cell;   // cell coordinates (floor(voxel centre / cluster_size))
     Eigen::Vector3d centre;  // mean of its frontier voxels' centres, m
     int64_t voxels = 0;
   };
@@ -42,14 +42,14 @@ class FrontierTracker {
     int64_t voxels = 0;
     int64_t sx = 0, sy = 0, sz = 0;  // sums of voxel keys
   };
-  mapper::VoxelKey cell_of(const mapper::VoxelKey& k) const;
-  void set(const mapper::VoxelKey& k, bool frontier);
-  void recheck(mapper::StateGrid::Reader& r, const mapper::VoxelKey& k);
+  map::VoxelKey cell_of(const map::VoxelKey& k) const;
+  void set(const map::VoxelKey& k, bool frontier);
+  void recheck(map::StateGrid::Reader& r, const map::VoxelKey& k);
 
   double cluster_size_;
   double resolution_ = 0.0;
-  std::unordered_set<mapper::VoxelKey> frontier_;
-  std::map<mapper::VoxelKey, Cell> cells_;
+  std::unordered_set<map::VoxelKey> frontier_;
+  std::map<map::VoxelKey, Cell> cells_;
 };
 
 }  // namespace semx::planner

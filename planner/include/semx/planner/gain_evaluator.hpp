@@ -1,7 +1,7 @@
 // The geometric gain G(n) = w_n U_n + w_f U_f + w_s U_s of a viewpoint (paper Eq. 1, DEP's
 // definition), per yaw bin, so each node gets the yaw whose camera window sees the most.
 //
-// Voxel kinds (disjoint; semx/mapper/state_grid.hpp, 6-connectivity):
+// Voxel kinds (disjoint; semx/map/state_grid.hpp, 6-connectivity):
 //   surface  (U_s): unknown, a free face neighbour and an occupied face neighbour;
 //   frontier (U_f): unknown, a free face neighbour, no occupied one;
 //   unknown  (U_n): any other unknown voxel ("normal").
@@ -30,7 +30,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
 #include "semx/planner/voxel_set.hpp"
 
@@ -70,18 +70,18 @@ class GainEvaluator {
   // Bin of an azimuth (rad).
   int bin_of(double azimuth) const;
   // The voxel's kind, or false when it is not unknown.
-  static bool classify(mapper::StateGrid::Reader& r, const mapper::VoxelKey& k, GainVoxel& kind);
+  static bool classify(map::StateGrid::Reader& r, const map::VoxelKey& k, GainVoxel& kind);
 
   // Ray-cast gain (the planner's). Not thread-safe (reuses a scratch bitset).
-  NodeGain evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats = nullptr);
+  NodeGain evaluate(const map::StateGrid& grid, const Eigen::Vector3d& p, GainStats* stats = nullptr);
   // As evaluate(), also listing the voxels counted in the window centred nearest to `yaw`.
-  NodeGain evaluate(const mapper::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
-                    std::vector<mapper::VoxelKey>* counted, GainStats* stats = nullptr);
+  NodeGain evaluate(const map::StateGrid& grid, const Eigen::Vector3d& p, double yaw,
+                    std::vector<map::VoxelKey>* counted, GainStats* stats = nullptr);
   // Voxels never to count (the unobservable ones, exploration_planner.hpp); null for none. Must
   // outlive the evaluator's use.
   void set_ignored(const VoxelSet* ignored) { ignored_ = ignored; }
   // Every voxel of the sector, each tested with its own line of sight (reference for tests).
-  NodeGain evaluate_exact(const mapper::StateGrid& grid, const Eigen::Vector3d& p) const;
+  NodeGain evaluate_exact(const map::StateGrid& grid, const Eigen::Vector3d& p) const;
 
   // First bin of the window centred nearest to `yaw`.
   int window_of(double yaw) const;
@@ -118,7 +118,7 @@ class GainEvaluator {
   std::vector<RayStep> ray_steps_;
   std::vector<uint32_t> ray_begin_;
   // The blocks around the node's, looked up in this evaluation (block_stamp_ == stamp_).
-  std::vector<const mapper::VoxelBlock*> block_ptr_;
+  std::vector<const map::VoxelBlock*> block_ptr_;
   std::vector<const VoxelSet::Mask*> ignored_ptr_;  // the ignored voxels of the same blocks
   mutable std::vector<double> sweep_prefix_;
   std::vector<uint32_t> block_stamp_;

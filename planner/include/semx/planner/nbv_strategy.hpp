@@ -31,9 +31,9 @@ class NbvStrategy : public Strategy {
  public:
   explicit NbvStrategy(const PlannerConfig& config);
 
-  void on_map_changes(const std::vector<mapper::VoxelChange>&) override {}
+  void on_map_changes(const std::vector<map::VoxelChange>&) override {}
   void on_map_reset() override {}
-  void on_gain_invalidated(const std::vector<mapper::VoxelKey>&) override {}
+  void on_gain_invalidated(const std::vector<map::VoxelKey>&) override {}
   PlanOutcome plan(PlanContext& ctx) override;
   std::optional<double> goal_score(PlanContext&, const Goal&) override { return std::nullopt; }
   void reject_goal(const Goal&, int64_t) override {}

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
@@ -22,7 +22,7 @@
 namespace semx::planner {
 
 struct PlanContext {
-  const mapper::StateGrid* grid = nullptr;
+  const map::StateGrid* grid = nullptr;
   VehiclePose pose;
   const std::vector<SemanticRegion>* regions = nullptr;  // empty when semantics are off
   const FrontierTracker* frontiers = nullptr;
@@ -58,11 +58,11 @@ class Strategy {
   virtual ~Strategy() = default;
 
   // The map changed (the grid already holds the new states) / was replaced wholesale.
-  virtual void on_map_changes(const std::vector<mapper::VoxelChange>& changes) = 0;
+  virtual void on_map_changes(const std::vector<map::VoxelChange>& changes) = 0;
   virtual void on_map_reset() = 0;
   // The gain model changed for these voxels (they became unobservable): cached gains in sensor
   // range of them are stale.
-  virtual void on_gain_invalidated(const std::vector<mapper::VoxelKey>& keys) = 0;
+  virtual void on_gain_invalidated(const std::vector<map::VoxelKey>& keys) = 0;
   // One planning cycle.
   virtual PlanOutcome plan(PlanContext& ctx) = 0;
   // The score the goal being flown has now (same cycle's roadmap), or nullopt when it is gone or

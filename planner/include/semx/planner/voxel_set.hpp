@@ -1,4 +1,4 @@
-// A set of voxel keys kept as one bit mask per map block (semx/mapper/voxel_key.hpp's blocks), so
+// A set of voxel keys kept as one bit mask per map block (semx/map/voxel_key.hpp's blocks), so
 // a loop that already walks the map block by block (the gain's rays) tests a voxel with one bit
 // read instead of a hash lookup: with std::unordered_set the unobservable voxels' lookups were
 // 8.8 % of the planner's time (perf, env3 DEP; about 10 % less planner CPU without them).
@@ -9,18 +9,18 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "semx/mapper/voxel_key.hpp"
+#include "semx/map/voxel_key.hpp"
 
 namespace semx::planner {
 
 class VoxelSet {
  public:
-  using Mask = std::array<uint64_t, mapper::kBlockVolume / 64>;
+  using Mask = std::array<uint64_t, map::kBlockVolume / 64>;
 
   // True when k was not in the set.
-  bool insert(const mapper::VoxelKey& k) {
-    Mask& m = blocks_[mapper::block_of(k)];
-    const int i = mapper::local_index(k);
+  bool insert(const map::VoxelKey& k) {
+    Mask& m = blocks_[map::block_of(k)];
+    const int i = map::local_index(k);
     uint64_t& word = m[static_cast<size_t>(i >> 6)];
     const uint64_t bit = uint64_t{1} << (i & 63);
     if (word & bit) return false;
@@ -28,12 +28,12 @@ class VoxelSet {
     ++size_;
     return true;
   }
-  bool contains(const mapper::VoxelKey& k) const {
-    const Mask* m = block_mask(mapper::block_of(k));
-    return m && test(*m, mapper::local_index(k));
+  bool contains(const map::VoxelKey& k) const {
+    const Mask* m = block_mask(map::block_of(k));
+    return m && test(*m, map::local_index(k));
   }
   // The members in the block with block coordinates `block`; null when it has none.
-  const Mask* block_mask(const mapper::VoxelKey& block) const {
+  const Mask* block_mask(const map::VoxelKey& block) const {
     const auto it = blocks_.find(block);
     return it == blocks_.end() ? nullptr : &it->second;
   }
@@ -48,7 +48,7 @@ class VoxelSet {
   }
 
  private:
-  std::unordered_map<mapper::VoxelKey, Mask> blocks_;
+  std::unordered_map<map::VoxelKey, Mask> blocks_;
   std::size_t size_ = 0;
 };
 

@@ -19,8 +19,8 @@
 #include <memory>
 #include <vector>
 
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/simulator/ground_truth.hpp"
 
 namespace semx::evaluator {
@@ -45,20 +45,20 @@ class CoverageTracker {
   double object_coverage() const;
 
   // Records the new state of one voxel (voxels outside T change nothing).
-  void set(const mapper::VoxelKey& key, mapper::VoxelState state);
+  void set(const map::VoxelKey& key, map::VoxelState state);
   // Applies every change of a delta. Returns false (and changes nothing) when the delta's
   // resolution is not the tracker's.
-  bool apply(const mapper::MapDelta& delta);
+  bool apply(const map::MapDelta& delta);
   // Forgets everything and recounts from `grid` (after a snapshot replaced the map). Returns
   // false (and leaves the tracker empty) when the grid's resolution is not the tracker's.
-  bool reset(const mapper::StateGrid& grid);
+  bool reset(const map::StateGrid& grid);
   // Forgets everything: coverage 0.
   void clear();
 
-  bool known(const mapper::VoxelKey& key) const;
+  bool known(const map::VoxelKey& key) const;
 
   // From scratch: the target voxels whose state in `grid` is not unknown (grid at gt's resolution).
-  static int64_t count_covered(const simulator::GroundTruth& gt, const mapper::StateGrid& grid);
+  static int64_t count_covered(const simulator::GroundTruth& gt, const map::StateGrid& grid);
 
  private:
   std::shared_ptr<const simulator::GroundTruth> gt_;

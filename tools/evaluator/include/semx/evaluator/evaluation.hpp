@@ -22,8 +22,8 @@
 #include "semx/evaluator/coverage_tracker.hpp"
 #include "semx/evaluator/run_metrics.hpp"
 #include "semx/evaluator/run_summary.hpp"
-#include "semx/mapper/map_delta.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/map_delta.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/simulator/world.hpp"
 
 namespace semx::evaluator {
@@ -45,9 +45,9 @@ class Evaluation {
   // ---- map ----
   // After the map applied `delta`; `grid_after` is the whole map then (used only when the
   // resolution changed and the ground truth had to be rebuilt).
-  void on_map_delta(const mapper::MapDelta& delta, const mapper::StateGrid& grid_after);
+  void on_map_delta(const map::MapDelta& delta, const map::StateGrid& grid_after);
   // After a snapshot replaced the map (stamped `utime`; `seq`: the map's sequence, if known).
-  void on_map_reset(const mapper::StateGrid& grid, int64_t utime, int64_t seq = -1);
+  void on_map_reset(const map::StateGrid& grid, int64_t utime, int64_t seq = -1);
 
   // ---- vehicle, planner, simulator ----
   void on_odometry(int64_t utime, const Eigen::Vector3d& position);

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "semx/evaluator/rgb.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
 
@@ -59,7 +59,7 @@ class MapPicture {
  public:
   enum class Column : uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2, kUnmappedWall = 3 };
 
-  MapPicture(const mapper::StateGrid& grid, const MapView& view, MapPictureOptions options = {});
+  MapPicture(const map::StateGrid& grid, const MapView& view, MapPictureOptions options = {});
 
   // Columns the map does not know but the ground truth holds occupied voxels in (same height
   // range) are drawn as unmapped walls.
@@ -118,7 +118,7 @@ class MapPicture {
 // walls the map does not know (when `gt` is given), and the flown trajectory with its start and
 // end. `beneath` adds overlays under the trajectory (the roadmap, the regions); overlays added
 // to the result draw on top.
-MapPicture run_map_picture(const mapper::StateGrid& grid, const simulator::World& world,
+MapPicture run_map_picture(const map::StateGrid& grid, const simulator::World& world,
                            const simulator::GroundTruth* gt, const std::vector<Eigen::Vector3d>& trajectory,
                            const std::string& title,
                            const std::function<void(MapPicture&)>& beneath = nullptr);

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "semx/evaluator/map_picture.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 
 namespace semx::evaluator {
 
@@ -33,6 +33,6 @@ void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions)
 // Every known voxel of `grid` as an OctoMap node at the clamping log-odds of its state (the
 // mirror holds states, not log-odds). Returns the number of voxels written; throws
 // std::runtime_error naming the file when it cannot be written.
-int64_t write_octomap_bt(const mapper::StateGrid& grid, const std::string& path);
+int64_t write_octomap_bt(const map::StateGrid& grid, const std::string& path);
 
 }  // namespace semx::evaluator

@@ -21,7 +21,7 @@
 
 #include "semx/evaluator/map_picture.hpp"
 #include "semx/evaluator/rgb.hpp"
-#include "semx/mapper/state_grid.hpp"
+#include "semx/map/state_grid.hpp"
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
 
@@ -148,13 +148,13 @@ class TopDownView {
 
   // ---- drawing ----
   // The header line: sim time, known volume of `grid`, planner and its state.
-  std::string header(const mapper::StateGrid* grid) const;
+  std::string header(const map::StateGrid* grid) const;
   // The area and heights the next frame shows (grows the remembered area; see options).
-  evaluator::MapView update_view(const mapper::StateGrid* grid);
+  evaluator::MapView update_view(const map::StateGrid* grid);
   // The picture of the current state over `grid` (nullptr: no map yet), with every overlay.
-  evaluator::MapPicture picture(const mapper::StateGrid* grid);
-  evaluator::Image render(const mapper::StateGrid* grid) { return picture(grid).render(); }
-  void write_png(const mapper::StateGrid* grid, const std::string& path) { picture(grid).write_png(path); }
+  evaluator::MapPicture picture(const map::StateGrid* grid);
+  evaluator::Image render(const map::StateGrid* grid) { return picture(grid).render(); }
+  void write_png(const map::StateGrid* grid, const std::string& path) { picture(grid).write_png(path); }
 
   // Colours: score_color(t) for a node whose score ranks at the fraction t in [0, 1] of the
   // roadmap's finite scores (0 the lowest, 1 the highest; purple, orange, red); edges take the
@@ -174,7 +174,7 @@ class TopDownView {
   TopDownViewOptions options_;
   std::optional<simulator::World> world_;
   std::optional<simulator::GroundTruth> gt_;
-  mapper::StateGrid empty_grid_{0.1};
+  map::StateGrid empty_grid_{0.1};
 
   std::vector<Eigen::Vector3d> trail_;
   std::optional<Eigen::Vector3d> pose_position_;
