@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "semx/map/esdf_distance.hpp"
+
 namespace semx::controller {
 
 GridDistanceField::GridDistanceField(const Eigen::Vector3d& origin, double resolution, int nx, int ny, int nz,
@@ -55,44 +57,11 @@ double GridDistanceField::distance(const Eigen::Vector3d& p, Eigen::Vector3d* gr
   if (values_.empty() || !contains(p)) {
     return outside_ == OutsideWindow::kFree ? max_distance_ : -max_distance_;
   }
-  // Neighbouring centres i0, i1 and weight w of i1 per axis; past the outermost centres both
-  // are the border cell (the value extends, the slope is zero).
-  int i0[3], i1[3];
-  double w[3], slope[3];
-  for (int a = 0; a < 3; ++a) {
-    const double u = (p[a] - origin_[a]) / resolution_ - 0.5;
-    const int lo = static_cast<int>(std::floor(u));
-    if (lo < 0) {
-      i0[a] = i1[a] = 0;
-      w[a] = 0.0;
-      slope[a] = 0.0;
-    } else if (lo >= n_[a] - 1) {
-      i0[a] = i1[a] = n_[a] - 1;
-      w[a] = 0.0;
-      slope[a] = 0.0;
-    } else {
-      i0[a] = lo;
-      i1[a] = lo + 1;
-      w[a] = u - lo;
-      slope[a] = 1.0 / resolution_;
-    }
-  }
-  const double c000 = values_[index(i0[0], i0[1], i0[2])], c100 = values_[index(i1[0], i0[1], i0[2])];
-  const double c010 = values_[index(i0[0], i1[1], i0[2])], c110 = values_[index(i1[0], i1[1], i0[2])];
-  const double c001 = values_[index(i0[0], i0[1], i1[2])], c101 = values_[index(i1[0], i0[1], i1[2])];
-  const double c011 = values_[index(i0[0], i1[1], i1[2])], c111 = values_[index(i1[0], i1[1], i1[2])];
-  const double wx = w[0], wy = w[1], wz = w[2];
-  const double c00 = c000 + wx * (c100 - c000), c10 = c010 + wx * (c110 - c010);
-  const double c01 = c001 + wx * (c101 - c001), c11 = c011 + wx * (c111 - c011);
-  const double c0 = c00 + wy * (c10 - c00), c1 = c01 + wy * (c11 - c01);
-  if (gradient) {
-    const double dx0 = (1 - wy) * (c100 - c000) + wy * (c110 - c010);
-    const double dx1 = (1 - wy) * (c101 - c001) + wy * (c111 - c011);
-    (*gradient)[0] = ((1 - wz) * dx0 + wz * dx1) * slope[0];
-    (*gradient)[1] = ((1 - wz) * (c10 - c00) + wz * (c11 - c01)) * slope[1];
-    (*gradient)[2] = (c1 - c0) * slope[2];
-  }
-  return c0 + wz * (c1 - c0);
+  double u[3];
+  for (int a = 0; a < 3; ++a) u[a] = (p[a] - origin_[a]) / resolution_ - 0.5;
+  return map::trilinear_distance(
+      u, n_, 1.0 / resolution_, [this](int x, int y, int z) { return static_cast<double>(values_[index(x, y, z)]); },
+      gradient);
 }
 
 }  // namespace semx::controller

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 
+#include "semx/map/esdf_distance.hpp"
+
 namespace semx::mapper {
 
 namespace {
@@ -189,7 +191,7 @@ void EsdfBuilder::compute(const map::StateGrid& grid) {
   const float res = static_cast<float>(grid_.resolution);
   const float dmax = static_cast<float>(params_.max_distance);
   for (size_t i = 0; i < n; ++i) {
-    const float d = obstacle_[i] ? -(std::sqrt(neg_[i]) - 0.5f) * res : (std::sqrt(pos_[i]) - 0.5f) * res;
+    const float d = obstacle_[i] ? -map::esdf_value(std::sqrt(neg_[i]), res) : map::esdf_value(std::sqrt(pos_[i]), res);
     grid_.distance[i] = std::min(std::max(d, -dmax), dmax);
   }
 }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "semx/map/esdf_distance.hpp"
 #include "semx/map/raycast.hpp"
 
 namespace semx::planner {
@@ -229,7 +230,7 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
       for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], g[i] + q);
     }
   }
-  for (int i = 0; i < kChunkVolume; ++i) out[i] = std::sqrt(static_cast<double>(best[i])) * res - 0.5 * res;
+  for (int i = 0; i < kChunkVolume; ++i) out[i] = map::esdf_value(std::sqrt(static_cast<double>(best[i])), res);
 }
 
 double CollisionChecker::centre_search(const VoxelKey& c, int reach, bool unknown_is_obstacle) const {
@@ -247,7 +248,7 @@ double CollisionChecker::centre_search(const VoxelKey& c, int reach, bool unknow
         return true;
       });
   const double res = grid_->resolution();
-  return std::sqrt(static_cast<double>(best2)) * res - 0.5 * res;
+  return map::esdf_value(std::sqrt(static_cast<double>(best2)), res);
 }
 
 bool CollisionChecker::region_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double radius,
@@ -288,15 +289,12 @@ double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown
   ++box_checks_;
   if (!grid_ || !p.allFinite()) return -1.0;
   const double res = grid_->resolution(), inv = 1.0 / res;
-  // The 8 voxel centres around p, as the controller's trilinear interpolation uses them.
-  Eigen::Vector3d f;
-  int32_t c0[3];
+  // The point in centre coordinates (voxel k's centre at u = k), far enough from the keys' limit
+  // that every corner and its search stay valid.
+  double u[3];
   for (int i = 0; i < 3; ++i) {
-    const double u = p[i] * inv - 0.5;
-    const double fl = std::floor(u);
-    if (std::abs(fl) >= map::kMaxKeyMagnitude - 64) return -1.0;
-    c0[i] = static_cast<int32_t>(fl);
-    f[i] = u - fl;
+    u[i] = p[i] * inv - 0.5;
+    if (std::abs(std::floor(u[i])) >= map::kMaxKeyMagnitude - 64) return -1.0;
   }
   // Corner values differ by at most a voxel diagonal, so when the result is below cap every
   // corner is below cap + diagonal, which a centre's search of reach_for(cap) finds exactly;
@@ -304,17 +302,13 @@ double CollisionChecker::esdf(const Eigen::Vector3d& p, double cap, bool unknown
   const bool cached = cap <= cache_cap_;
   if (cached) validate_cache();
   const int reach = cached ? 0 : reach_for(cap, res);
-  double v = 0.0;
-  for (int c = 0; c < 8; ++c) {
-    double w = 1.0;
-    for (int i = 0; i < 3; ++i) w *= ((c >> i) & 1) ? f[i] : 1.0 - f[i];
-    if (w == 0.0) continue;
-    const VoxelKey k{c0[0] + (c & 1), c0[1] + ((c >> 1) & 1), c0[2] + ((c >> 2) & 1)};
-    // The mapper's value at a free voxel: centre-to-centre distance minus half a voxel (an
-    // obstacle voxel itself reads -half a voxel, which fails every positive requirement).
-    v += w * (cached ? centre_value(k, unknown_is_obstacle) : centre_search(k, reach, unknown_is_obstacle));
-  }
-  return v;
+  // The field has no border: every voxel's value is computed from the states around it (an
+  // obstacle voxel itself reads -half a voxel, which fails every positive requirement).
+  const int unbounded[3] = {0, 0, 0};
+  return map::trilinear_distance(u, unbounded, inv, [&](int x, int y, int z) {
+    const VoxelKey k{x, y, z};
+    return cached ? centre_value(k, unknown_is_obstacle) : centre_search(k, reach, unknown_is_obstacle);
+  });
 }
 
 bool CollisionChecker::clear(const Eigen::Vector3d& p, const Eigen::Vector3d& half, double distance) const {

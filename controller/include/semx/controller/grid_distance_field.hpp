@@ -1,9 +1,9 @@
 // A DistanceField over a dense grid laid out as ESDF_LOCAL: cell (ix, iy, iz) at index
 // ix + nx*(iy + ny*iz), its centre at origin + (i + 0.5)·resolution, values in metres.
 //
-// Between cell centres the distance is trilinear and the gradient is that interpolant's exact
-// derivative (so the optimiser's gradient and the checked values agree). Within half a cell of
-// the window's faces the border values extend outwards; beyond the window the space is free
+// Between cell centres the field is map::trilinear_distance (semx/map/esdf_distance.hpp: the one
+// ESDF query, which the planner's clearance uses too). Within half a cell of the window's faces
+// the border values extend outwards; beyond the window the space is free
 // (max_distance, zero gradient) or an obstacle (-max_distance), as configured; a non-finite point
 // is an obstacle.
 #pragma once

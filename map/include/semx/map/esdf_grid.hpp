@@ -1,6 +1,5 @@
-// A Euclidean signed distance field over a box of voxels (what ESDF_LOCAL carries), with the
-// queries a controller needs. Built by EsdfBuilder (esdf_builder.hpp), which documents the
-// definition of the values.
+// A Euclidean signed distance field over a box of voxels (what ESDF_LOCAL carries). Its values
+// are esdf_distance.hpp's, computed by the mapper's EsdfBuilder.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,9 +33,9 @@ struct EsdfGrid {
   }
   // Value of the voxel with key k; false when k is outside the window.
   bool voxel_distance(const VoxelKey& k, float* d) const;
-  // Trilinear interpolation between voxel centres, and its gradient (1/m). Within half a voxel of
-  // the window's faces the border values are extended. False when p is outside the window or
-  // not finite.
+  // The field at p (esdf_distance.hpp's trilinear_distance, the query every reader uses) and its
+  // gradient (1/m). Within half a voxel of the window's faces the border values extend. False
+  // when p is outside the window or not finite.
   bool interpolate(const Eigen::Vector3d& p, double* distance, Eigen::Vector3d* gradient = nullptr) const;
 };
 

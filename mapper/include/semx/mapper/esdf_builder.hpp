@@ -1,10 +1,9 @@
 // Computes the Euclidean signed distance field over a window around the vehicle (ESDF_LOCAL).
 //
-// Obstacle voxels are the occupied ones, plus the unknown ones when unknown_as_occupied. For a
-// voxel outside obstacles the value is the distance from its centre to the nearest obstacle
-// voxel's centre minus half a voxel (so it approximates the distance to the obstacle's face and
-// is continuous in sign across a boundary); inside obstacles it is minus the same distance to the
-// nearest non-obstacle voxel. Values are clamped to +-max_distance. Only voxels inside the window
+// Obstacle voxels are the occupied ones, plus the unknown ones when unknown_as_occupied. A voxel's
+// value is map::esdf_value (semx/map/esdf_distance.hpp) of the distance from its centre to the
+// nearest obstacle voxel's centre; inside obstacles, minus that of the distance to the nearest
+// non-obstacle voxel. Values are clamped to +-max_distance. Only voxels inside the window
 // are considered: an obstacle just outside it is not seen, so distances near the window border
 // are upper bounds (the window is centred on the vehicle, where the field matters).
 //
