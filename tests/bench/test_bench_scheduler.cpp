@@ -3,6 +3,7 @@
 // Ctrl-C, the LCM log removed, and the kernel's UDP drop counter read by its header.
 #include <gtest/gtest.h>
 
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -205,6 +206,7 @@ TEST(BenchScheduler, SlotsRunAtOnceEachOnItsPort) {
 TEST(BenchScheduler, SigintStartsNoMoreRunsAndARerunContinues) {
   const std::string root = temp_dir("sigint");
   SchedulerOptions o = fake_options(root);
+  signal(SIGINT, SIG_DFL);  // whatever ctest was started with
   // The first run sends SIGINT to the bench and then finishes: it gets its line, the second is
   // not started.
   const std::vector<BenchRun> runs = {{"env1", "nbv", "45", 1, "300"}, {"env1", "dep", "45", 1, "300"}};
@@ -221,6 +223,18 @@ TEST(BenchScheduler, SigintStartsNoMoreRunsAndARerunContinues) {
   ASSERT_EQ(m.size(), 2u) << again.str();
   EXPECT_EQ(m[0], "[1/2] env1-nbv-s45-seed1: done before, kept");
   EXPECT_EQ(m[1].rfind("[2/2] env1-dep-s45-seed1: coverage 98.8 %", 0), 0u);
+  fs::remove_all(root);
+}
+
+TEST(BenchScheduler, ASigintIgnoredOnEntryStaysIgnored) {
+  const std::string root = temp_dir("sigign");
+  SchedulerOptions o = fake_options(root);
+  signal(SIGINT, SIG_IGN);  // a bench started with & from a script
+  const std::vector<BenchRun> runs = {{"env1", "nbv", "45", 1, "300"}, {"env1", "dep", "45", 1, "300"}};
+  std::ostringstream out;
+  EXPECT_EQ(run_bench(runs, o, out, steady_now_s()), 0);
+  signal(SIGINT, SIG_DFL);
+  EXPECT_EQ(lines(out.str()).size(), 2u) << out.str();
   fs::remove_all(root);
 }
 

@@ -49,7 +49,10 @@ class SignalScope {
     sa.sa_handler = on_bench_signal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, &old_int_);
+    // A SIGINT ignored on entry stays ignored (a bench started with `&` from a script), as a
+    // shell keeps it and as the bash bench did.
+    sigaction(SIGINT, nullptr, &old_int_);
+    if (old_int_.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, nullptr);
     sa.sa_flags = SA_RESTART | SA_NOCLDSTOP;
     sigaction(SIGCHLD, &sa, &old_chld_);
   }

@@ -50,8 +50,8 @@ std::optional<std::string> result_line(int k, int total, const std::string& name
 
 // Runs every run of `runs` whose folder has no metrics.json, `o.slots` at a time, in order,
 // printing to `out` a line per run as it ends (or "done before, kept"). Returns 130 when SIGINT
-// came (the runs already started are waited for), else 0. Elapsed seconds count from `t0_s`, a
-// steady_clock time in seconds.
+// came (the runs already started are waited for), else 0; a SIGINT ignored on entry stays
+// ignored. Elapsed seconds count from `t0_s`, a steady_clock time in seconds.
 int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std::ostream& out, double t0_s);
 
 // steady_clock now, in seconds.
