@@ -304,6 +304,7 @@ int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std:
     for (auto& s : args) argv.push_back(s.data());
     argv.push_back(nullptr);
     const pid_t pid = fork();
+    const int fork_errno = errno;
     if (pid == 0) {
       dup2(log, STDOUT_FILENO);
       dup2(log, STDERR_FILENO);
@@ -321,7 +322,7 @@ int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std:
     }
     ::close(log);
     if (pid < 0) {
-      say(run_tag(k, total, a.name) + ": FAILED (fork: " + std::strerror(errno) + ")");
+      say(run_tag(k, total, a.name) + ": FAILED (fork: " + std::strerror(fork_errno) + ")");
       return;
     }
     a.pid = pid;
