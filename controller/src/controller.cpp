@@ -2,17 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+
+#include "semx/core/text.hpp"
 
 namespace semx::controller {
 namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
 
 int64_t micros(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e6)); }
 
@@ -53,11 +47,11 @@ std::string Controller::stale_reason(int64_t now) const {
   // Reasons carry the limits, not the ages, so the status does not "change" every step.
   if (!odometry_) return "no odometry yet";
   if (now - odometry_->utime > micros(config_.safety.max_odometry_age)) {
-    return "odometry older than " + fmt(config_.safety.max_odometry_age) + " s";
+    return "odometry older than " + core::short_number(config_.safety.max_odometry_age) + " s";
   }
   if (!esdf_) return "no ESDF yet";
   if (now - esdf_utime_ > micros(config_.safety.max_esdf_age)) {
-    return "ESDF older than " + fmt(config_.safety.max_esdf_age) + " s";
+    return "ESDF older than " + core::short_number(config_.safety.max_esdf_age) + " s";
   }
   return "";
 }
@@ -80,7 +74,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   const Path path = std::move(*pending_);
   pending_.reset();
   if (now - path.utime > micros(config_.path.max_age)) {
-    reject(path, "older than " + fmt(config_.path.max_age) + " s", false);
+    reject(path, "older than " + core::short_number(config_.path.max_age) + " s", false);
     return;
   }
   const std::string why = check_path_start(path, odometry_->position, config_.path);
@@ -147,8 +141,9 @@ StepOutput Controller::step(int64_t now) {
                                                 generator_.flight_rule(trajectory_->optimized));
       if (!c.ok) {
         ++counters_.brakes;
-        stop(ControllerState::kBraking, "predicted collision in " + fmt(c.violation_time - t) +
-                                            " s: ESDF distance " + fmt(c.violation_distance) + " m");
+        stop(ControllerState::kBraking, "predicted collision in " + core::short_number(c.violation_time - t) +
+                                            " s: ESDF distance " + core::short_number(c.violation_distance) +
+                                            " m");
       }
     }
     esdf_new_ = false;

@@ -60,8 +60,8 @@ double GridDistanceField::distance(const Eigen::Vector3d& p, Eigen::Vector3d* gr
   double u[3];
   for (int a = 0; a < 3; ++a) u[a] = (p[a] - origin_[a]) / resolution_ - 0.5;
   return map::trilinear_distance(
-      u, n_, 1.0 / resolution_, [this](int x, int y, int z) { return static_cast<double>(values_[index(x, y, z)]); },
-      gradient);
+      u, n_, 1.0 / resolution_,
+      [this](int x, int y, int z) { return static_cast<double>(values_[index(x, y, z)]); }, gradient);
 }
 
 }  // namespace semx::controller

@@ -1,21 +1,11 @@
 #include "semx/controller/path.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include "semx/core/angles.hpp"
+#include "semx/core/text.hpp"
 
 namespace semx::controller {
-namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
-
-}  // namespace
 
 std::string check_path(const Path& path, const PathConfig& config) {
   const std::size_t n = path.waypoints.size();
@@ -24,7 +14,8 @@ std::string check_path(const Path& path, const PathConfig& config) {
   if (static_cast<int64_t>(n) > config.max_waypoints) {
     return std::to_string(n) + " waypoints (max " + std::to_string(config.max_waypoints) + ")";
   }
-  if (!std::isfinite(path.max_speed) || path.max_speed < 0) return "max_speed " + fmt(path.max_speed);
+  if (!std::isfinite(path.max_speed) || path.max_speed < 0)
+    return "max_speed " + core::short_number(path.max_speed);
   for (std::size_t i = 0; i < n; ++i) {
     if (!path.waypoints[i].allFinite()) return "waypoint " + std::to_string(i) + " is not finite";
     if (!std::isfinite(path.yaws[i])) return "yaw " + std::to_string(i) + " is not finite";
@@ -32,8 +23,8 @@ std::string check_path(const Path& path, const PathConfig& config) {
   for (std::size_t i = 1; i < n; ++i) {
     const double d = (path.waypoints[i] - path.waypoints[i - 1]).norm();
     if (d > config.max_segment_length) {
-      return "jump of " + fmt(d) + " m between waypoints " + std::to_string(i - 1) + " and " +
-             std::to_string(i) + " (max " + fmt(config.max_segment_length) + " m)";
+      return "jump of " + core::short_number(d) + " m between waypoints " + std::to_string(i - 1) + " and " +
+             std::to_string(i) + " (max " + core::short_number(config.max_segment_length) + " m)";
     }
   }
   return "";
@@ -44,7 +35,8 @@ std::string check_path_start(const Path& path, const Eigen::Vector3d& vehicle, c
   if (!why.empty()) return why;
   const double d = (path.waypoints.front() - vehicle).norm();
   if (!(d <= config.max_start_offset)) {
-    return "first waypoint " + fmt(d) + " m from the vehicle (max " + fmt(config.max_start_offset) + " m)";
+    return "first waypoint " + core::short_number(d) + " m from the vehicle (max " +
+           core::short_number(config.max_start_offset) + " m)";
   }
   return "";
 }

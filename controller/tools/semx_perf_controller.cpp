@@ -12,9 +12,9 @@
 
 #include "semx/controller/clearance.hpp"
 #include "semx/controller/controller_config.hpp"
-#include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/controller/tracking_controller.hpp"
 #include "semx/controller/trajectory_generator.hpp"
+#include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/runtime/args.hpp"
 
 using namespace semx::controller;

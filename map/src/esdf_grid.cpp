@@ -23,8 +23,8 @@ bool EsdfGrid::interpolate(const Eigen::Vector3d& p, double* dist, Eigen::Vector
     u[a] = cells - 0.5;
   }
   *dist = trilinear_distance(
-      u, n, 1.0 / resolution, [&](int x, int y, int z) { return static_cast<double>(distance[index(x, y, z)]); },
-      gradient);
+      u, n, 1.0 / resolution,
+      [&](int x, int y, int z) { return static_cast<double>(distance[index(x, y, z)]); }, gradient);
   return true;
 }
 

@@ -28,8 +28,9 @@ std::string decode_depth(const semx::depth_image_t& m, DecodedDepth& out) {
 }
 
 semx::depth_image_t depth_message(const DepthFrame& f, bool compress, int64_t frame_id) {
-  return runtime::depth_image_message(f.camera, f.T_world_optical, f.depth, f.depth_size, f.utime, frame_id,
-                                      compress ? runtime::ImageCompression::kZlib : runtime::ImageCompression::kNone);
+  return runtime::depth_image_message(
+      f.camera, f.T_world_optical, f.depth, f.depth_size, f.utime, frame_id,
+      compress ? runtime::ImageCompression::kZlib : runtime::ImageCompression::kNone);
 }
 
 // ---- ODOMETRY ----

@@ -54,12 +54,12 @@ int main(int argc, char** argv) {
       std::cerr << "semx-map-replay: " << log << ": no " << channel << " events (channels: " << seen << ")\n";
       return 1;
     }
-    std::printf("semx-map-replay: frames integrated %lld, skipped %lld (frame_period_s), rejected %lld, "
-                "malformed %lld%s%s\n",
-                static_cast<long long>(r.integrated), static_cast<long long>(r.skipped),
-                static_cast<long long>(r.rejected),
-                static_cast<long long>(r.malformed),
-                r.first_error.empty() ? "" : "; first problem: ", r.first_error.c_str());
+    std::printf(
+        "semx-map-replay: frames integrated %lld, skipped %lld (frame_period_s), rejected %lld, "
+        "malformed %lld%s%s\n",
+        static_cast<long long>(r.integrated), static_cast<long long>(r.skipped),
+        static_cast<long long>(r.rejected), static_cast<long long>(r.malformed),
+        r.first_error.empty() ? "" : "; first problem: ", r.first_error.c_str());
     if (r.integrated == 0) {
       std::cerr << "semx-map-replay: " << log << ": none of the " << r.depth_events
                 << " frames could be integrated; nothing written\n";

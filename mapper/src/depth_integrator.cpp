@@ -257,8 +257,8 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
   rep.accepted = true;
   // Two voxels of margin: a walk can overshoot its segment's box by one voxel on rounding.
   const map::VoxelKey origin{static_cast<int32_t>(std::floor(lo.x())) - 2,
-                        static_cast<int32_t>(std::floor(lo.y())) - 2,
-                        static_cast<int32_t>(std::floor(lo.z())) - 2};
+                             static_cast<int32_t>(std::floor(lo.y())) - 2,
+                             static_cast<int32_t>(std::floor(lo.z())) - 2};
   const int nx = static_cast<int>(std::floor(hi.x())) + 3 - origin.x;
   const int ny = static_cast<int>(std::floor(hi.y())) + 3 - origin.y;
   const int nz = static_cast<int>(std::floor(hi.z())) + 3 - origin.z;
@@ -363,8 +363,8 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
       if (!(m & kWalked)) continue;  // a max-range end voxel nothing else passed through
       const uint32_t idx = static_cast<uint32_t>(w * 8 + b);
       const map::VoxelKey key{origin.x + static_cast<int32_t>(idx & mask_x),
-                         origin.y + static_cast<int32_t>((idx >> sx) & mask_y),
-                         origin.z + static_cast<int32_t>(idx >> sxy)};
+                              origin.y + static_cast<int32_t>((idx >> sx) & mask_y),
+                              origin.z + static_cast<int32_t>(idx >> sxy)};
       ++rep.voxels_updated;
       if (bounds && !bounds->contains(key)) {
         ++rep.out_of_bounds;

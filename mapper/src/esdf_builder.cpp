@@ -126,8 +126,8 @@ map::VoxelKey EsdfBuilder::window_origin(const Eigen::Vector3d& center) const {
   return {c.x - grid_.nx / 2, c.y - grid_.ny / 2, c.z - grid_.nz / 2};
 }
 
-bool EsdfBuilder::update(const map::StateGrid& grid, const Eigen::Vector3d& center, const map::KeyBox& changed,
-                         int64_t map_seq, bool force) {
+bool EsdfBuilder::update(const map::StateGrid& grid, const Eigen::Vector3d& center,
+                         const map::KeyBox& changed, int64_t map_seq, bool force) {
   map::VoxelKey probe;
   if (!map::KeyMath(grid_.resolution).key(center, probe)) return false;
   const map::VoxelKey origin = window_origin(center);
@@ -174,7 +174,8 @@ void EsdfBuilder::compute(const map::StateGrid& grid) {
                 &b->state[((y - base.y) << map::kBlockBits) | ((z - base.z) << (2 * map::kBlockBits))];
             for (int x = x0; x <= x1; ++x) {
               const map::VoxelState s = row[x - base.x];
-              dst[x - x0] = s == map::VoxelState::kOccupied ? 1 : (s == map::VoxelState::kUnknown ? unknown_value : 0);
+              dst[x - x0] =
+                  s == map::VoxelState::kOccupied ? 1 : (s == map::VoxelState::kUnknown ? unknown_value : 0);
             }
           }
         }
@@ -191,7 +192,8 @@ void EsdfBuilder::compute(const map::StateGrid& grid) {
   const float res = static_cast<float>(grid_.resolution);
   const float dmax = static_cast<float>(params_.max_distance);
   for (size_t i = 0; i < n; ++i) {
-    const float d = obstacle_[i] ? -map::esdf_value(std::sqrt(neg_[i]), res) : map::esdf_value(std::sqrt(pos_[i]), res);
+    const float d =
+        obstacle_[i] ? -map::esdf_value(std::sqrt(neg_[i]), res) : map::esdf_value(std::sqrt(pos_[i]), res);
     grid_.distance[i] = std::min(std::max(d, -dmax), dmax);
   }
 }

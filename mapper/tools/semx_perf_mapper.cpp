@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "semx/fixtures/synthetic_room.hpp"
 #include "semx/mapper/map_export.hpp"
 #include "semx/mapper/mapper.hpp"
-#include "semx/fixtures/synthetic_room.hpp"
 
 namespace sm = semx::mapper;
 using Clock = std::chrono::steady_clock;
@@ -74,7 +74,8 @@ Agreement compare(const semx::map::StateGrid& grid, const octomap::OcTree& tree)
       const octomap::OcTreeNode* n = tree.search(octomap::OcTreeKey(k.x + kOff, k.y + kOff, k.z + kOff));
       if (!n) {
         ++a.only_ours;
-      } else if ((tree.isNodeOccupied(n) ? semx::map::VoxelState::kOccupied : semx::map::VoxelState::kFree) == s) {
+      } else if ((tree.isNodeOccupied(n) ? semx::map::VoxelState::kOccupied : semx::map::VoxelState::kFree) ==
+                 s) {
         ++a.agree;
       } else {
         ++a.free_vs_occupied;
@@ -242,7 +243,8 @@ int main(int argc, char** argv) {
       if (r == 0) {
         for (InsideCase& c : inside) {
           const Stamp a = Stamp::now();
-          c.builder->update(mapper->map().grid(), f.pose.translation(), semx::map::KeyBox(), 0, /*force=*/true);
+          c.builder->update(mapper->map().grid(), f.pose.translation(), semx::map::KeyBox(), 0,
+                            /*force=*/true);
           c.cpu_ms.push_back(Stamp::now().cpu_ms - a.cpu_ms);
           c.transforms += c.builder->last_inside_transform();
         }

@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "semx/core/angles.hpp"
-#include "semx/planner/travel_cost.hpp"
 #include "semx/core/stopwatch.hpp"
+#include "semx/planner/travel_cost.hpp"
 
 namespace semx::planner {
 

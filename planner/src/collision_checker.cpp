@@ -48,9 +48,9 @@ bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const V
         for (int z = z0; z <= z1; ++z) {
           for (int y = y0; y <= y1; ++y) {
             if (!row_wanted(base.y + y, base.z + z)) continue;
-            const VoxelState* row = b ? &b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
-                                                                      (y << map::kBlockBits))]
-                                      : nullptr;
+            const VoxelState* row =
+                b ? &b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) | (y << map::kBlockBits))]
+                  : nullptr;
             for (int x = x0; x <= x1; ++x) {
               const VoxelState st = row ? row[x] : VoxelState::kUnknown;
               if (st == VoxelState::kFree || (st == VoxelState::kUnknown && !unknown_is_obstacle)) continue;
@@ -230,7 +230,8 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
       for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], g[i] + q);
     }
   }
-  for (int i = 0; i < kChunkVolume; ++i) out[i] = map::esdf_value(std::sqrt(static_cast<double>(best[i])), res);
+  for (int i = 0; i < kChunkVolume; ++i)
+    out[i] = map::esdf_value(std::sqrt(static_cast<double>(best[i])), res);
 }
 
 double CollisionChecker::centre_search(const VoxelKey& c, int reach, bool unknown_is_obstacle) const {

@@ -8,9 +8,9 @@
 #include <utility>
 
 #include "semx/core/angles.hpp"
+#include "semx/core/stopwatch.hpp"
 #include "semx/planner/travel_cost.hpp"
 #include "semx/runtime/semantic_classes.hpp"
-#include "semx/core/stopwatch.hpp"
 
 namespace semx::planner {
 
@@ -474,8 +474,8 @@ DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t i
   return f;
 }
 
-Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason, int64_t* unreachable,
-                              bool sweep) {
+Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
+                              int64_t* unreachable, bool sweep) {
   {
     core::Stopwatch w;
     search_ = graph_.shortest_paths(root_);

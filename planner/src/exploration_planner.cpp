@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "semx/core/angles.hpp"
-#include "semx/planner/charge_model.hpp"
 #include "semx/core/stopwatch.hpp"
+#include "semx/planner/charge_model.hpp"
 
 namespace semx::planner {
 

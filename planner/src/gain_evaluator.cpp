@@ -5,8 +5,8 @@
 #include <cstring>
 #include <limits>
 
-#include "semx/map/raycast.hpp"
 #include "semx/core/angles.hpp"
+#include "semx/map/raycast.hpp"
 
 namespace semx::planner {
 
@@ -25,13 +25,15 @@ int64_t NodeGain::total_voxels() const {
 
 GainEvaluator::GainEvaluator(const GainConfig& config) : config_(config) {
   const int bins = config_.yaw_bins;
-  window_ = std::clamp(static_cast<int>(std::lround(config_.horizontal_fov() / (2.0 * core::kPi / bins))), 1, bins);
+  window_ =
+      std::clamp(static_cast<int>(std::lround(config_.horizontal_fov() / (2.0 * core::kPi / bins))), 1, bins);
   const double half_vfov = 0.5 * config_.vertical_fov();
   // The image's vertical extent shrinks off-axis: at horizontal angle a from the optical axis a
   // pixel row sees elevations up to atan(tan(vfov/2) cos a). Counting only what every column of
   // the window sees (a = hfov/2) keeps the model conservative: a voxel counted for a window is
   // seen when the camera looks along that window's centre (up to occlusion).
-  tan_half_vfov_ = std::tan(half_vfov) * std::cos(std::min(0.5 * config_.horizontal_fov(), 0.5 * core::kPi - 1e-6));
+  tan_half_vfov_ =
+      std::tan(half_vfov) * std::cos(std::min(0.5 * config_.horizontal_fov(), 0.5 * core::kPi - 1e-6));
   const int na = config_.rays_azimuth, ne = config_.rays_elevation;
   directions_.reserve(static_cast<size_t>(na) * ne);
   for (int e = 0; e < ne; ++e) {
@@ -75,7 +77,9 @@ int GainEvaluator::bin_near(const Eigen::Vector3d& c, int b) const {
 
 double GainEvaluator::bin_width() const { return 2.0 * core::kPi / config_.yaw_bins; }
 
-double GainEvaluator::window_yaw(int j) const { return core::wrap_angle(-core::kPi + (j + 0.5 * window_) * bin_width()); }
+double GainEvaluator::window_yaw(int j) const {
+  return core::wrap_angle(-core::kPi + (j + 0.5 * window_) * bin_width());
+}
 
 int GainEvaluator::bin_of(double azimuth) const {
   const int b = static_cast<int>(std::floor((azimuth + core::kPi) / bin_width()));
@@ -144,7 +148,8 @@ void GainEvaluator::finish(NodeGain& g) const {
 int GainEvaluator::window_of(double yaw) const {
   // Window j is centred at -pi + (j + W/2) * width.
   const int bins = config_.yaw_bins;
-  const int j = static_cast<int>(std::lround((core::wrap_angle(yaw) + core::kPi) / bin_width() - 0.5 * window_));
+  const int j =
+      static_cast<int>(std::lround((core::wrap_angle(yaw) + core::kPi) / bin_width() - 0.5 * window_));
   return ((j % bins) + bins) % bins;
 }
 
@@ -165,7 +170,8 @@ void GainEvaluator::sweep_gains(const NodeGain& g, double from_yaw, std::vector<
   std::vector<double>& prefix = sweep_prefix_;
   prefix.assign(static_cast<size_t>(2 * bins + 1), 0.0);
   for (int k = 0; k < 2 * bins; ++k)
-    prefix[static_cast<size_t>(k + 1)] = prefix[static_cast<size_t>(k)] + g.bin_gain[static_cast<size_t>(k % bins)];
+    prefix[static_cast<size_t>(k + 1)] =
+        prefix[static_cast<size_t>(k)] + g.bin_gain[static_cast<size_t>(k % bins)];
   const int from = window_of(from_yaw);
   for (int j = 0; j < bins; ++j) {
     // Counter-clockwise (increasing bins) from `from` to j, or clockwise from j to `from`; at a
@@ -265,8 +271,7 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
   const int nx = 2 * hx_ + 1;
   map::StateGrid::Reader neighbour_reader = grid.reader();
   const VoxelKey origin_block = map::block_of(origin);
-  const int ox = origin.x & map::kBlockMask, oy = origin.y & map::kBlockMask,
-            oz = origin.z & map::kBlockMask;
+  const int ox = origin.x & map::kBlockMask, oy = origin.y & map::kBlockMask, oz = origin.z & map::kBlockMask;
   const map::VoxelBlock* origin_b = grid.find_block(origin_block);
   const bool ignore = ignored_ && !ignored_->empty();
   const VoxelSet::Mask* origin_ignored = ignore ? ignored_->block_mask(origin_block) : nullptr;
@@ -305,8 +310,7 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
         ignored_mask = ignored_ptr_[slot];
       }
       const int lx = ux & map::kBlockMask, ly = uy & map::kBlockMask, lz = uz & map::kBlockMask;
-      const size_t li =
-          static_cast<size_t>(lx | (ly << map::kBlockBits) | (lz << (2 * map::kBlockBits)));
+      const size_t li = static_cast<size_t>(lx | (ly << map::kBlockBits) | (lz << (2 * map::kBlockBits)));
       const VoxelState s = b ? b->state[li] : VoxelState::kUnknown;
       if (s == VoxelState::kOccupied) break;
       if (s != VoxelState::kUnknown) continue;

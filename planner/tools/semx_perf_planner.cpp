@@ -22,13 +22,13 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/random.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
+#include "semx/fixtures/synthetic_world.hpp"
 #include "semx/planner/charge_model.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/exploration_planner.hpp"
-#include "semx/fixtures/exploration_sim.hpp"
 #include "semx/planner/gain_evaluator.hpp"
-#include "semx/core/random.hpp"
-#include "semx/fixtures/synthetic_world.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
 

@@ -38,8 +38,7 @@ void load_bt(const std::string& path, map::StateGrid& grid) {
                                ", the planner's map has 0.1 m");
   const map::KeyMath km(res);
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const map::VoxelState s =
-        tree.isNodeOccupied(*it) ? map::VoxelState::kOccupied : map::VoxelState::kFree;
+    const map::VoxelState s = tree.isNodeOccupied(*it) ? map::VoxelState::kOccupied : map::VoxelState::kFree;
     const int n = static_cast<int>(std::lround(it.getSize() / res));  // a pruned leaf spans n^3 voxels
     const octomap::point3d c = it.getCoordinate();
     const Eigen::Vector3d lo(c.x() - 0.5 * it.getSize() + 0.5 * res, c.y() - 0.5 * it.getSize() + 0.5 * res,
@@ -207,7 +206,7 @@ int main(int argc, char** argv) {
         const map::VoxelState v = grid.state(q);
         return v == map::VoxelState::kFree       ? "free"
                : v == map::VoxelState::kOccupied ? "occupied"
-                                                    : "unknown";
+                                                 : "unknown";
       };
       for (const Eigen::Vector3d& q : {a, b})
         std::printf("point (%.2f %.2f %.2f): %s, node_free %d, passage_free %d, vehicle_free %d, esdf %.3f\n",

@@ -50,7 +50,7 @@ LogLayout scan_log(const std::string& path) {
     const std::string where = " at byte " + std::to_string(pos) + " (event " + std::to_string(l.events) + ")";
     if (be32(h) != kSync) {
       throw LogError(pos == 0 ? path + ": not an LCM log (no event sync word at byte 0)"
-                                 : path + ": corrupt log: no event sync word" + where);
+                              : path + ": corrupt log: no event sync word" + where);
     }
     const auto channel_len = static_cast<int32_t>(be32(h + 20));
     const auto data_len = static_cast<int32_t>(be32(h + 24));

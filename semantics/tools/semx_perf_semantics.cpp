@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <vector>
 
-#include "simulator_messages.hpp"
 #include "semantics_messages.hpp"
 #include "semantics_sim.hpp"
 #include "semx/runtime/args.hpp"
@@ -19,6 +18,7 @@
 #include "semx/semantics/pipeline.hpp"
 #include "semx/simulator/quadrotor.hpp"
 #include "semx/simulator/rasterizer.hpp"
+#include "simulator_messages.hpp"
 
 using namespace semx::semantics;
 using Clock = std::chrono::steady_clock;

@@ -18,16 +18,6 @@ void put_vec(double out[3], const Eigen::Vector3d& v) {
   for (int i = 0; i < 3; ++i) out[i] = v[i];
 }
 
-// Little-endian bytes of a uint16 image (the wire format whatever the host).
-std::vector<uint8_t> le_bytes(const std::vector<uint16_t>& a) {
-  std::vector<uint8_t> out(a.size() * 2);
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    out[2 * i] = static_cast<uint8_t>(a[i] & 0xFF);
-    out[2 * i + 1] = static_cast<uint8_t>(a[i] >> 8);
-  }
-  return out;
-}
-
 // The kRle payload of an RGB image given as its maximal runs: the runs are the payload's
 // records, split at the 16-bit count. Byte for byte the payload of runtime::encode_image on the
 // image; returns its size, or 0 where encode_image would fall back to raw bytes (or the runs do

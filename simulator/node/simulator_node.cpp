@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "simulator_messages.hpp"
 #include "semx/runtime/channels.hpp"
+#include "simulator_messages.hpp"
 
 namespace semx::simulator {
 

@@ -154,8 +154,9 @@ StepReport Quadrotor::step(double dt) {
   Eigen::Vector3d v = limit_velocity(prev.velocity + accel * dt, c);
   const Eigen::Vector3d p = prev.position + 0.5 * (prev.velocity + v) * dt;
 
-  double rate_cmd = cmd_.yaw_mode == ControlCommand::kYawRate ? cmd_.yaw_rate
-                                                              : c.yaw_gain * core::wrap_angle(cmd_.yaw - prev.yaw);
+  double rate_cmd = cmd_.yaw_mode == ControlCommand::kYawRate
+                        ? cmd_.yaw_rate
+                        : c.yaw_gain * core::wrap_angle(cmd_.yaw - prev.yaw);
   if (cmd_.mode == ControlCommand::kHold) rate_cmd = 0;
   rate_cmd = std::clamp(rate_cmd, -c.max_yaw_rate, c.max_yaw_rate);
   const double alpha = std::min(1.0, dt / c.yaw_time_constant);

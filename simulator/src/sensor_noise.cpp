@@ -5,8 +5,8 @@
 #include <map>
 #include <vector>
 
-#include "semx/runtime/semantic_classes.hpp"
 #include "semx/core/random.hpp"
+#include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::simulator {
 

@@ -117,7 +117,8 @@ void Simulator::render_camera(CameraFrame& out, unsigned channels) {
   out.frame_id = camera_count_;
   const uint64_t id = static_cast<uint64_t>(camera_count_);
   if (channels & kRenderDepth) {
-    apply_depth_noise(out.depth, config_.depth_noise, core::mix_seed(core::mix_seed(config_.seed, kDepthStream), id));
+    apply_depth_noise(out.depth, config_.depth_noise,
+                      core::mix_seed(core::mix_seed(config_.seed, kDepthStream), id));
   }
   if (channels & kRenderLabels) {
     apply_detection_noise(out, config_.detection_noise,

@@ -12,8 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "semx/simulator/ground_truth.hpp"
 #include "semx/core/random.hpp"
+#include "semx/runtime/executable_dir.hpp"
+#include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/ray_caster.hpp"
 #include "semx/simulator/simulator.hpp"
@@ -48,11 +49,7 @@ std::vector<Eigen::Isometry3d> sample_poses(const sim::World& w, int n, uint64_t
 // The whole simulator process in LOCKSTEP with no registered node, over loopback udpm on a port
 // of its own: the figure the issue asks for (rendering, encoding and publishing every frame).
 double process_realtime_factor(const std::string& world, double seconds, bool rgb) {
-  char exe[4096];
-  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n <= 0) return -1;
-  exe[n] = '\0';
-  const std::string dir = std::string(exe).substr(0, std::string(exe).rfind('/'));
+  const std::string dir = semx::runtime::executable_dir();
   const std::string url =
       "udpm://239.255.76.67:" + std::to_string(23000 + getpid() % 1000) + "?ttl=0&recv_buf_size=4194304";
   const std::string cmd = "'" + dir + "/semx-simulator' --world " + world + " --clock lockstep --duration " +

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/random.hpp"
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/quadrotor.hpp"
-#include "semx/core/random.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/world.hpp"
 #include "semx/simulator/world_generator.hpp"

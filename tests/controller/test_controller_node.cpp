@@ -5,8 +5,8 @@
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 
-#include "controller_node.hpp"
 #include "controller_messages.hpp"
+#include "controller_node.hpp"
 #include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/runtime/channels.hpp"
 

@@ -5,11 +5,11 @@
 #include <random>
 
 #include "fields.hpp"
-#include "semx/core/angles.hpp"
 #include "semx/controller/fallback.hpp"
-#include "semx/fixtures/synthetic_scene.hpp"
 #include "semx/controller/time_allocation.hpp"
 #include "semx/controller/trajectory_generator.hpp"
+#include "semx/core/angles.hpp"
+#include "semx/fixtures/synthetic_scene.hpp"
 
 using namespace semx::controller;
 using semx::controller::test::FreeField;

@@ -6,8 +6,8 @@
 
 #include <memory>
 
-#include "semx/core/angles.hpp"
 #include "semx/controller/controller.hpp"
+#include "semx/core/angles.hpp"
 
 namespace semx::controller::test {
 
@@ -30,8 +30,8 @@ struct PointMass {
     position += 0.5 * (velocity + v) * dt;
     velocity = v;
     if (!hold)
-      yaw =
-          core::wrap_angle(yaw + std::clamp(yaw_gain * core::wrap_angle(c.yaw - yaw), -max_yaw_rate, max_yaw_rate) * dt);
+      yaw = core::wrap_angle(
+          yaw + std::clamp(yaw_gain * core::wrap_angle(c.yaw - yaw), -max_yaw_rate, max_yaw_rate) * dt);
   }
 };
 

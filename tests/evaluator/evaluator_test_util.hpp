@@ -51,7 +51,7 @@ inline std::string small_world_file(const std::string& dir) {
 // voxel with its ground-truth state, plus a few voxels outside the target set (every fourth
 // delta is empty). Delta k (seq k+1) is stamped t0 + k * dt.
 inline std::vector<map::MapDelta> sweep_deltas(const simulator::GroundTruth& gt, int n, int64_t t0_us,
-                                                  int64_t dt_us) {
+                                               int64_t dt_us) {
   std::vector<map::VoxelKey> keys;
   const Eigen::Vector3i lo = gt.min_key(), d = gt.dims();
   for (int x = 0; x < d.x(); ++x) {

@@ -115,8 +115,8 @@ inline std::vector<SceneEvent> make_scene(const simulator::GroundTruth& gt, cons
       for (const auto& c : d.changes) truth.set_state(c.key, c.state);
       if (d.seq != o.lose_seq) out.push_back(scene_event(ch::MAP_UPDATE, map::to_message(d)));
       if (d.seq == o.snapshot_after_seq) {
-        out.push_back(scene_event(ch::MAP_SNAPSHOT,
-                                  map::to_message(map::encode_snapshot(truth, d.seq, d.utime))));
+        out.push_back(
+            scene_event(ch::MAP_SNAPSHOT, map::to_message(map::encode_snapshot(truth, d.seq, d.utime))));
       }
     }
   }

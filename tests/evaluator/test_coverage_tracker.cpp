@@ -49,8 +49,8 @@ TEST(CoverageTracker, IncrementalCountEqualsBruteForceOnRandomDeltas) {
       const map::VoxelKey k(dx(rng), dy(rng), dz(rng));
       if (!used.insert(k).second) continue;
       const int s = state(rng);
-      const auto vs = s == 0 ? map::VoxelState::kUnknown
-                             : (s < 7 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
+      const auto vs =
+          s == 0 ? map::VoxelState::kUnknown : (s < 7 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
       d.changes.push_back({k, vs});
       grid.set_state(k, vs);
     }

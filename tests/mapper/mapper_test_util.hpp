@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "semx/fixtures/synthetic_room.hpp"
 #include "semx/map/map_mirror.hpp"
 #include "semx/mapper/mapper.hpp"
-#include "semx/fixtures/synthetic_room.hpp"
 
 namespace semx::mapper::test {
 
@@ -93,13 +93,15 @@ inline double agreement(const map::StateGrid& grid, octomap::OcTree& tree) {
       const map::VoxelKey k = map::voxel_of(bk, i);
       const octomap::OcTreeNode* n = tree.search(octomap::OcTreeKey(k.x + kOff, k.y + kOff, k.z + kOff));
       ++total;
-      if (n && (tree.isNodeOccupied(n) ? map::VoxelState::kOccupied : map::VoxelState::kFree) == b.state[i]) ++agree;
+      if (n && (tree.isNodeOccupied(n) ? map::VoxelState::kOccupied : map::VoxelState::kFree) == b.state[i])
+        ++agree;
     }
   });
   tree.expand();
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     const octomap::OcTreeKey k = it.getKey();
-    if (grid.state(map::VoxelKey{k[0] - kOff, k[1] - kOff, k[2] - kOff}) == map::VoxelState::kUnknown) ++total;
+    if (grid.state(map::VoxelKey{k[0] - kOff, k[1] - kOff, k[2] - kOff}) == map::VoxelState::kUnknown)
+      ++total;
   }
   return total ? static_cast<double>(agree) / total : 1.0;
 }

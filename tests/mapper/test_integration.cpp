@@ -59,7 +59,8 @@ TEST(Integration, RayBeyondMaxRangeClearsUpToTheRangeWithoutAnObstacle) {
   EXPECT_EQ(res.report.hits, 0);
   const OccupancyMap& map = r.mapper.map();
   // The max-range point x = 5.05 lies in voxel 50, which is not observed (OctoMap's convention).
-  for (int x = 0; x < 50; ++x) EXPECT_EQ(map.state(map::VoxelKey{x, 0, 0}), map::VoxelState::kFree) << "x=" << x;
+  for (int x = 0; x < 50; ++x)
+    EXPECT_EQ(map.state(map::VoxelKey{x, 0, 0}), map::VoxelState::kFree) << "x=" << x;
   EXPECT_EQ(map.state(map::VoxelKey{50, 0, 0}), map::VoxelState::kUnknown);
   EXPECT_EQ(map.state(map::VoxelKey{70, 0, 0}), map::VoxelState::kUnknown);
   EXPECT_EQ(map.grid().occupied_voxels(), 0);
@@ -120,7 +121,8 @@ TEST(Integration, EachVoxelGetsOneObservationPerFrameAndHitsWin) {
     const OccupancyMap& map = mapper.map();
     EXPECT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), map.hit_log_odds());
     EXPECT_EQ(*map.log_odds(map::VoxelKey{20, 0, 0}), map.hit_log_odds());
-    for (int x : {0, 3, 9, 11, 19}) EXPECT_EQ(*map.log_odds(map::VoxelKey{x, 0, 0}), map.miss_log_odds()) << x;
+    for (int x : {0, 3, 9, 11, 19})
+      EXPECT_EQ(*map.log_odds(map::VoxelKey{x, 0, 0}), map.miss_log_odds()) << x;
   }
 }
 
@@ -217,11 +219,13 @@ TEST(Integration, MapGrowsToWhereverTheCameraLooks) {
     const Eigen::Vector3d dir = (ahead - pose.translation()).normalized();
     const double t = room.cast(pose.translation(), dir);
     // The return lands within a millimetre of the wall, on either side of the voxel boundary.
-    const bool wall =
-        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t + 0.01))) == map::VoxelState::kOccupied ||
-        mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t - 0.01))) == map::VoxelState::kOccupied;
+    const bool wall = mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t + 0.01))) ==
+                          map::VoxelState::kOccupied ||
+                      mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t - 0.01))) ==
+                          map::VoxelState::kOccupied;
     EXPECT_TRUE(wall);
-    EXPECT_EQ(mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t * 0.5))), map::VoxelState::kFree);
+    EXPECT_EQ(mapper.map().state(Eigen::Vector3d(pose.translation() + dir * (t * 0.5))),
+              map::VoxelState::kFree);
   }
   const map::MapStats s = mapper.stats(false);
   EXPECT_LT(s.bounds_min.x(), -1230.0);

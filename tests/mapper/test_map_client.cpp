@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "map_client.hpp"
-#include "mapper_node.hpp"
-#include "mapper_test_util.hpp"
 #include "map_messages.hpp"
 #include "mapper_messages.hpp"
+#include "mapper_node.hpp"
+#include "mapper_test_util.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::mapper {
@@ -231,7 +231,8 @@ TEST(MapClient, FixedResolutionIgnoresAnotherMappersMessages) {
   o.resolution = 0.1;
   o.quiet = true;
   map::MapClient client(node, o);
-  node.publish(ch::MAP_UPDATE, map::to_message(map::MapDelta{1, 0, 0.2, {{{0, 0, 0}, map::VoxelState::kFree}}}));
+  node.publish(ch::MAP_UPDATE,
+               map::to_message(map::MapDelta{1, 0, 0.2, {{{0, 0, 0}, map::VoxelState::kFree}}}));
   node.drain();
   EXPECT_EQ(client.counters().resolution_mismatches, 1);
   EXPECT_EQ(client.seq(), 0);

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "map_replay.hpp"
-#include "mapper_test_util.hpp"
 #include "map_messages.hpp"
+#include "map_replay.hpp"
 #include "mapper_messages.hpp"
+#include "mapper_test_util.hpp"
 #include "semx/mapper/checkpoint.hpp"
 
 namespace semx::mapper {
@@ -255,8 +255,8 @@ TEST(MapReplay, ExecutableWritesTheFilesAndFailsClearly) {
   const TestLog log = write_log("exe.lcmlog", test::room_frames(3, cam, 3), cam);
   const std::string dir = temp_file("exe_out");
   fs::remove_all(dir);
-  RunResult r = run_program({kBin + "/semx-map-replay", log.path, "--out", dir, "--set", "resolution=0.2", "--set",
-                             "integration.frame_period_s=0"});
+  RunResult r = run_program({kBin + "/semx-map-replay", log.path, "--out", dir, "--set", "resolution=0.2",
+                             "--set", "integration.frame_period_s=0"});
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("frames integrated 3, skipped 0 (frame_period_s), rejected 0, malformed 2"),
             std::string::npos)

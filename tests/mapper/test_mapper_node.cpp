@@ -16,10 +16,10 @@
 #include <thread>
 #include <vector>
 
-#include "mapper_node.hpp"
-#include "mapper_test_util.hpp"
 #include "map_messages.hpp"
 #include "mapper_messages.hpp"
+#include "mapper_node.hpp"
+#include "mapper_test_util.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_url.hpp"
 

@@ -14,9 +14,9 @@
 #include <string>
 
 #include "../tools/process_harness.hpp"
-#include "mapper_test_util.hpp"
 #include "map_messages.hpp"
 #include "mapper_messages.hpp"
+#include "mapper_test_util.hpp"
 #include "semx/mapper/checkpoint.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/node.hpp"

@@ -8,7 +8,8 @@
 namespace semx::mapper {
 namespace {
 
-constexpr map::VoxelState U = map::VoxelState::kUnknown, F = map::VoxelState::kFree, O = map::VoxelState::kOccupied;
+constexpr map::VoxelState U = map::VoxelState::kUnknown, F = map::VoxelState::kFree,
+                          O = map::VoxelState::kOccupied;
 
 TEST(Queries, FrontierIsUnknownWithAFreeFaceNeighbour) {
   map::StateGrid g(0.1);

@@ -45,7 +45,8 @@ TEST(Streaming, EmptyMapSnapshot) {
 
 TEST(Streaming, MalformedSnapshotsAreRejectedAndLeaveTheMirrorAlone) {
   map::StateGrid g(0.1);
-  for (int i = 0; i < 50; ++i) g.set_state({i, -i, 2 * i}, i % 3 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
+  for (int i = 0; i < 50; ++i)
+    g.set_state({i, -i, 2 * i}, i % 3 ? map::VoxelState::kFree : map::VoxelState::kOccupied);
   const map::MapSnapshot good = map::encode_snapshot(g, 5);
   map::MapMirror mirror(0.1);
   ASSERT_EQ(mirror.apply(good), map::MapMirror::SnapshotResult::kApplied);

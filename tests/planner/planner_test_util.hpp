@@ -3,15 +3,14 @@
 
 #include <Eigen/Core>
 
+#include "semx/fixtures/synthetic_world.hpp"
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/fixtures/synthetic_world.hpp"
 
 namespace semx::planner {
 
 // Sets every voxel of the inclusive key box to s.
-inline void fill(map::StateGrid& g, const map::VoxelKey& lo, const map::VoxelKey& hi,
-                 map::VoxelState s) {
+inline void fill(map::StateGrid& g, const map::VoxelKey& lo, const map::VoxelKey& hi, map::VoxelState s) {
   for (int32_t z = lo.z; z <= hi.z; ++z)
     for (int32_t y = lo.y; y <= hi.y; ++y)
       for (int32_t x = lo.x; x <= hi.x; ++x) g.set_state({x, y, z}, s);

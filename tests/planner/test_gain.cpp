@@ -192,8 +192,9 @@ TEST(Gain, ATurnSweepsEveryWindowItPassesTheShorterWay) {
   EXPECT_DOUBLE_EQ(sweep[20], ccw ? bins_sum(4, 16 + w) : bins_sum(20, 16 + w));
   for (int j = 0; j < bins; ++j) {
     EXPECT_DOUBLE_EQ(e.sweep_gain(g, e.window_yaw(from), j), sweep[static_cast<size_t>(j)]);
-    EXPECT_GE(sweep[static_cast<size_t>(j)], e.gain_at_yaw(g, e.window_yaw(j)) - 1e-9);  // never less than the window
-    EXPECT_LE(sweep[static_cast<size_t>(j)], bins_sum(0, bins) + 1e-9);                 // each bin once
+    EXPECT_GE(sweep[static_cast<size_t>(j)],
+              e.gain_at_yaw(g, e.window_yaw(j)) - 1e-9);                 // never less than the window
+    EXPECT_LE(sweep[static_cast<size_t>(j)], bins_sum(0, bins) + 1e-9);  // each bin once
   }
 }
 

@@ -7,10 +7,10 @@
 
 #include "planner_test_util.hpp"
 #include "semx/core/angles.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/exploration_planner.hpp"
-#include "semx/fixtures/exploration_sim.hpp"
 #include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
@@ -56,8 +56,8 @@ TEST(Planner, PicksTheGoalFacingTheKnownFrontier) {
   ASSERT_TRUE(path);
   const Goal& goal = p.goal();
   ASSERT_TRUE(goal.valid);
-  EXPECT_GT(goal.position.x(), 3.5);            // toward the frontier, clear of it
-  EXPECT_LT(goal.position.x(), 6.1 - 0.45);     // in known free space with the clearance
+  EXPECT_GT(goal.position.x(), 3.5);                  // toward the frontier, clear of it
+  EXPECT_LT(goal.position.x(), 6.1 - 0.45);           // in known free space with the clearance
   EXPECT_LT(core::yaw_distance(goal.yaw, 0.0), 0.4);  // looking at it
   EXPECT_EQ(path->waypoints.front(), Eigen::Vector3d(1, 2, 1.2));
   EXPECT_EQ(path->waypoints.back(), goal.position);

@@ -32,7 +32,8 @@ TEST(SemanticReward, BoundaryCases) {
 TEST(SemanticReward, InViewRewardsOnlyWhatTheNodesYawLooksAt) {
   const SemanticRegion s = region({1, 2, 1}, 30.0, 2.0);
   const Eigen::Vector3d node(2, 2, 1);  // 1 m east of the object: it lies at azimuth 180°
-  const ViewCone west{core::kPi, 0.25 * core::kPi}, north{0.5 * core::kPi, 0.25 * core::kPi}, edge{0.75 * core::kPi + 1e-9, 0.25 * core::kPi};
+  const ViewCone west{core::kPi, 0.25 * core::kPi}, north{0.5 * core::kPi, 0.25 * core::kPi},
+      edge{0.75 * core::kPi + 1e-9, 0.25 * core::kPi};
   EXPECT_DOUBLE_EQ(region_reward(node, s, &west), 15.0);
   EXPECT_DOUBLE_EQ(region_reward(node, s, &north), 0.0);  // looking away
   EXPECT_DOUBLE_EQ(region_reward(node, s, &edge), 15.0);  // at the edge of the 90° window
@@ -106,7 +107,8 @@ TEST(Score, OrdersByUtilityOverTime) {
   const CostConfig c;  // v = 1, ω = 1, w_psi = 1, turning while flying
   const double near_small = node_score(100, 0, travel_time(2.0, 0.0, c));  // 50
   const double far_big = node_score(300, 0, travel_time(10.0, 0.0, c));    // 30
-  const double near_turn = node_score(100, 0, travel_time(2.0, core::kPi, c));   // 100 / π: the turn takes longer
+  const double near_turn =
+      node_score(100, 0, travel_time(2.0, core::kPi, c));  // 100 / π: the turn takes longer
   const double near_small_turn = node_score(100, 0, travel_time(2.0, 1.0, c));  // 50: turned on the way
   const double rewarded = node_score(100, 50, travel_time(2.0, 0.0, c));        // 75
   EXPECT_DOUBLE_EQ(near_small, 50.0);

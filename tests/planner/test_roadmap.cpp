@@ -509,7 +509,8 @@ TEST(DepRoadmap, AGoalThroughADoorwayIsChargedTheTurnItsPathFlies) {
     if (!o.goal.valid) continue;
     ++goals;
     double turn = 0.0;
-    for (size_t i = 1; i < o.goal.yaws.size(); ++i) turn += core::yaw_distance(o.goal.yaws[i - 1], o.goal.yaws[i]);
+    for (size_t i = 1; i < o.goal.yaws.size(); ++i)
+      turn += core::yaw_distance(o.goal.yaws[i - 1], o.goal.yaws[i]);
     turn += core::yaw_distance(ctx.pose.yaw, o.goal.yaws.front());
     // The cost is the travel time of the turn flown (charged the direct turn, the goals through
     // the doorway of this room scored above those that do not turn back and won).
@@ -582,8 +583,7 @@ TEST(DepRoadmap, RecoveryRelinksEdgesAClearedObstacleHadCut) {
   dep.plan(ctx);
   const std::vector<map::VoxelChange> wall = wall_across_corridor(f.grid);
   std::vector<map::VoxelChange> cleared;
-  for (const map::VoxelChange& c : wall)
-    cleared.push_back({c.key, VoxelState::kFree, VoxelState::kOccupied});
+  for (const map::VoxelChange& c : wall) cleared.push_back({c.key, VoxelState::kFree, VoxelState::kOccupied});
   dep.on_map_changes(wall);
   PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
   dep.process_map_changes(ctx2);

@@ -32,7 +32,7 @@ TEST(VoxelSet, AgreesWithAHashSet) {
 
 TEST(VoxelSet, BlockMasksHoldTheirBlocksMembersOnly) {
   VoxelSet s;
-  s.insert({-1, 0, 0});                  // block (-1, 0, 0)
+  s.insert({-1, 0, 0});               // block (-1, 0, 0)
   s.insert({map::kBlockSize, 0, 0});  // block (1, 0, 0)
   EXPECT_EQ(s.block_mask({0, 0, 0}), nullptr);
   const VoxelSet::Mask* m = s.block_mask({-1, 0, 0});

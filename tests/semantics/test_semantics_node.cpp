@@ -5,11 +5,11 @@
 #include <limits>
 #include <semx/clock_t.hpp>
 
-#include "simulator_messages.hpp"
 #include "semantics_messages.hpp"
 #include "semantics_node.hpp"
 #include "semantics_test_util.hpp"
 #include "semx/runtime/channels.hpp"
+#include "simulator_messages.hpp"
 
 using namespace semx::semantics;
 using namespace semx::semantics::test;

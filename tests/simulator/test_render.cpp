@@ -5,8 +5,8 @@
 #include <set>
 #include <tuple>
 
-#include "semx/simulator/ground_truth.hpp"
 #include "semx/core/random.hpp"
+#include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/rasterizer.hpp"
 #include "semx/simulator/ray_caster.hpp"
 #include "semx/simulator/sensor_noise.hpp"

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "simulator_messages.hpp"
 #include "semx/runtime/channels.hpp"
+#include "simulator_messages.hpp"
 #include "simulator_node.hpp"
 #include "test_util.hpp"
 

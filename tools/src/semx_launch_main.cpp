@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/executable_dir.hpp"
 #include "semx/runtime/lcm_url.hpp"
 #include "semx/tools/launch_set.hpp"
 #include "semx/tools/supervisor.hpp"
@@ -17,14 +18,6 @@ using namespace semx::tools;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string executable_dir() {
-  char buf[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return ".";
-  buf[n] = '\0';
-  return fs::path(buf).parent_path().string();
-}
 
 std::string source_root() {
   if (const char* env = std::getenv("SEMX_ROOT")) return env;
@@ -45,12 +38,13 @@ int main(int argc, char** argv) {
         "says, Ctrl-C stops everything. SET is a file or a name in tools/launch/ (without .yaml).");
     p.positional("SET", "the process set", &set_name)
         .repeated("arg", "NAME=VALUE", "set one of the set's args (see --list)", &arg_list)
-        .repeated("without", "NAME", "do not start process NAME (one the set marks required: false)", &without)
+        .repeated("without", "NAME", "do not start process NAME (one the set marks required: false)",
+                  &without)
         .option("lcm-url", "URL", "LCM provider for every process (exported as LCM_DEFAULT_URL)", &lcm_url)
         .option("duration", "S", "stop the set after S wall seconds", &duration)
         .option("grace", "S", "seconds between SIGINT and SIGKILL when stopping (default 5)", &grace)
-        .option("log-dir", "DIR", "write each process's output to DIR/NAME.log too (overrides the set's log_dir)",
-                &log_dir)
+        .option("log-dir", "DIR",
+                "write each process's output to DIR/NAME.log too (overrides the set's log_dir)", &log_dir)
         .flag("list", "print the set's args and processes and exit", &list)
         .flag("no-color", "do not colour process names", &no_color);
     if (!p.parse(argc, argv)) return 0;

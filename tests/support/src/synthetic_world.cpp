@@ -169,10 +169,9 @@ bool SyntheticWorld::collides(const Eigen::Vector3d& p, const Eigen::Vector3d& s
   return false;
 }
 
-std::vector<map::VoxelChange> SyntheticWorld::observe(map::StateGrid& known,
-                                                         const Eigen::Vector3d& position, double yaw,
-                                                         const runtime::PinholeCamera& cam,
-                                                         int pixel_step) const {
+std::vector<map::VoxelChange> SyntheticWorld::observe(map::StateGrid& known, const Eigen::Vector3d& position,
+                                                      double yaw, const runtime::PinholeCamera& cam,
+                                                      int pixel_step) const {
   std::vector<map::VoxelChange> changes;
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * runtime::optical_in_body();

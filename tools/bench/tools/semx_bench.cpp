@@ -16,19 +16,12 @@
 #include "semx/bench/bench_plan.hpp"
 #include "semx/bench/bench_scheduler.hpp"
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/executable_dir.hpp"
 
 using namespace semx;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string executable_dir() {
-  char buf[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return ".";
-  buf[n] = '\0';
-  return fs::path(buf).parent_path().string();
-}
 
 std::string now_stamp() {
   const std::time_t t = std::time(nullptr);
@@ -71,7 +64,7 @@ int main(int argc, char** argv) {
               << (jobs > 1 ? " (" + o.jobs + " at a time)" : "") << std::endl;
     bench::SchedulerOptions so;
     so.out_dir = out;
-    so.launcher = executable_dir() + "/semx-launch";
+    so.launcher = runtime::executable_dir() + "/semx-launch";
     so.slots = jobs;
     so.keep_logs = o.keep_logs;
     so.clock = o.clock;
@@ -84,7 +77,7 @@ int main(int argc, char** argv) {
     std::cout << "semx: bench: " << runs.size() << " runs in "
               << static_cast<long long>(bench::steady_now_s() - t0) << " s" << std::endl;
     std::fflush(stdout);
-    const std::string report = executable_dir() + "/semx-bench-report";
+    const std::string report = runtime::executable_dir() + "/semx-bench-report";
     execl(report.c_str(), report.c_str(), out.c_str(), static_cast<char*>(nullptr));
     throw std::runtime_error("cannot run '" + report + "': " + std::strerror(errno));
   });

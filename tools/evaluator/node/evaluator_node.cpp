@@ -118,9 +118,8 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
   // It publishes nothing but its map client's requests: with the mirror in sync the clock need
   // not wait for it (it ends the set from message time, wherever the clock is by then).
-  node_.on_quiet_until([this](int64_t utime) {
-    return map_.in_sync() ? std::numeric_limits<int64_t>::max() : utime;
-  });
+  node_.on_quiet_until(
+      [this](int64_t utime) { return map_.in_sync() ? std::numeric_limits<int64_t>::max() : utime; });
   node_.set_state(runtime::NodeState::kRunning, "waiting for the simulation");
 }
 
@@ -159,8 +158,8 @@ void EvaluatorNode::progress(int64_t utime) {
   if (t < next_progress_s_) return;
   next_progress_s_ = (std::floor(t / options_.progress_s) + 1) * options_.progress_s;
   const auto& m = evaluation_.metrics();
-  const std::string line =
-      format_progress(t, m.coverage_pct(), m.object_coverage_pct(), m.distance_m(), to_string(m.planner_state()));
+  const std::string line = format_progress(t, m.coverage_pct(), m.object_coverage_pct(), m.distance_m(),
+                                           to_string(m.planner_state()));
   if (options_.print) {
     std::printf("semx-evaluator: %s\n", line.c_str());
     std::fflush(stdout);

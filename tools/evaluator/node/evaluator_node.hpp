@@ -70,7 +70,7 @@ class EvaluatorNode {
   double next_progress_s_ = 0;
   std::vector<std::string> written_;
   bool write_failed_ = false;
-  RoadmapOverlay roadmap_;               // the planner's last ROADMAP
+  RoadmapOverlay roadmap_;              // the planner's last ROADMAP
   std::vector<RegionOverlay> regions_;  // the last SEMANTIC_REGIONS
 };
 

@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "semx/runtime/log_scan.hpp"
 #include "semx/evaluator/evaluation.hpp"
 #include "semx/map/map_mirror.hpp"
+#include "semx/runtime/log_scan.hpp"
 
 namespace semx::evaluator {
 

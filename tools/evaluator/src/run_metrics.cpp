@@ -32,7 +32,8 @@ double percent(int64_t covered, int64_t target) {
 // The first update at or above `threshold` (a fraction) fixes `at`; later ones do not move it.
 void note_threshold(int64_t utime, int64_t covered, int64_t target, double threshold,
                     std::optional<int64_t>& at) {
-  if (!at && target > 0 && static_cast<double>(covered) / static_cast<double>(target) >= threshold) at = utime;
+  if (!at && target > 0 && static_cast<double>(covered) / static_cast<double>(target) >= threshold)
+    at = utime;
 }
 }  // namespace
 
@@ -139,9 +140,7 @@ void RunMetrics::finish(Termination why, int64_t utime, double time_limit_s) {
 
 double RunMetrics::time_f_s() const { return finished() ? time_f_s_ : seconds(now_utime_); }
 
-double RunMetrics::coverage_pct() const {
-  return percent(covered_, target_);
-}
+double RunMetrics::coverage_pct() const { return percent(covered_, target_); }
 
 std::optional<double> RunMetrics::time_r_s() const {
   if (!time_r_utime_) return std::nullopt;

@@ -18,7 +18,9 @@ inline double wrap_angle(double a) {
 inline double yaw_distance(double a, double b) { return std::abs(wrap_angle(b - a)); }
 
 // The angle equal to `target` modulo 2 pi that is closest to `reference` (the shortest turn).
-inline double unwrap_near(double target, double reference) { return reference + wrap_angle(target - reference); }
+inline double unwrap_near(double target, double reference) {
+  return reference + wrap_angle(target - reference);
+}
 
 // Yaw of a world-from-body unit quaternion (w, x, y, z), z up.
 inline double yaw_of_quaternion(double w, double x, double y, double z) {

@@ -48,7 +48,8 @@ class Xoshiro256StarStar {
  public:
   explicit Xoshiro256StarStar(uint64_t seed = 1) { reseed(seed); }
   // From the four words themselves (the reference implementation's test vectors).
-  explicit Xoshiro256StarStar(const std::array<uint64_t, 4>& state) : s_{state[0], state[1], state[2], state[3]} {}
+  explicit Xoshiro256StarStar(const std::array<uint64_t, 4>& state)
+      : s_{state[0], state[1], state[2], state[3]} {}
   void reseed(uint64_t seed) {
     uint64_t x = seed;
     for (auto& s : s_) {
@@ -86,9 +87,13 @@ class Random {
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   // Uniform integer in [0, n), n > 0 (multiply-shift; bias below 2^-40 for any n < 2^24).
-  uint64_t below(uint64_t n) { return static_cast<uint64_t>((static_cast<unsigned __int128>(next()) * n) >> 64); }
+  uint64_t below(uint64_t n) {
+    return static_cast<uint64_t>((static_cast<unsigned __int128>(next()) * n) >> 64);
+  }
   // Uniform integer in [lo, hi].
-  int uniform_int(int lo, int hi) { return lo + static_cast<int>(uniform() * (static_cast<double>(hi) - lo + 1.0)); }
+  int uniform_int(int lo, int hi) {
+    return lo + static_cast<int>(uniform() * (static_cast<double>(hi) - lo + 1.0));
+  }
   bool bernoulli(double p) { return uniform() < p; }
   // Standard normal (Box-Muller, caching the second value).
   double normal() {

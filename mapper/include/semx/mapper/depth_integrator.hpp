@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "semx/mapper/depth_frame.hpp"
 #include "semx/map/map_delta.hpp"
+#include "semx/mapper/depth_frame.hpp"
 #include "semx/mapper/mapper_config.hpp"
 #include "semx/mapper/occupancy_map.hpp"
 
@@ -42,7 +42,7 @@ struct IntegrationReport {
   int64_t voxels_updated = 0;  // voxels that received an observation
   int64_t voxels_changed = 0;  // of which changed state
   int64_t out_of_bounds = 0;   // observations dropped by the configured bounds
-  map::KeyBox changed_bounds;       // bounding box of the changed voxels
+  map::KeyBox changed_bounds;  // bounding box of the changed voxels
 };
 
 namespace detail {
@@ -63,7 +63,8 @@ class DepthIntegrator {
 
   // Integrates one frame. Appends the state changes to *changes when given. A rejected frame
   // leaves the map untouched.
-  IntegrationReport integrate(const DepthFrame& frame, OccupancyMap& map, std::vector<map::VoxelChange>* changes);
+  IntegrationReport integrate(const DepthFrame& frame, OccupancyMap& map,
+                              std::vector<map::VoxelChange>* changes);
 
   const IntegrationParams& params() const { return params_; }
 

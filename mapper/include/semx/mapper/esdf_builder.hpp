@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "semx/map/esdf_grid.hpp"
-#include "semx/mapper/mapper_config.hpp"
 #include "semx/map/state_grid.hpp"
+#include "semx/mapper/mapper_config.hpp"
 
 namespace semx::mapper {
 
@@ -30,8 +30,8 @@ class EsdfBuilder {
   // Recomputes the field over the window centred on `center` when the window moved, `changed`
   // (voxels whose state changed since the last call) intersects it, or `force`. Returns whether
   // it recomputed.
-  bool update(const map::StateGrid& grid, const Eigen::Vector3d& center, const map::KeyBox& changed, int64_t map_seq,
-              bool force = false);
+  bool update(const map::StateGrid& grid, const Eigen::Vector3d& center, const map::KeyBox& changed,
+              int64_t map_seq, bool force = false);
   const map::EsdfGrid& grid() const { return grid_; }
   const EsdfParams& params() const { return params_; }
   // Whether the last computation found the inside distances with the full transform (too many

@@ -14,12 +14,12 @@
 #include <cstdint>
 #include <string>
 
-#include "semx/mapper/checkpoint.hpp"
-#include "semx/mapper/depth_integrator.hpp"
-#include "semx/mapper/esdf_builder.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/map_snapshot.hpp"
 #include "semx/map/map_stats.hpp"
+#include "semx/mapper/checkpoint.hpp"
+#include "semx/mapper/depth_integrator.hpp"
+#include "semx/mapper/esdf_builder.hpp"
 #include "semx/mapper/mapper_config.hpp"
 #include "semx/mapper/occupancy_map.hpp"
 
@@ -54,7 +54,9 @@ class Mapper {
   const map::EsdfGrid& esdf() const { return esdf_.grid(); }
   double esdf_ms() const { return esdf_ms_; }
 
-  map::MapSnapshot snapshot(int64_t utime = 0) const { return map::encode_snapshot(map_.grid(), seq_, utime); }
+  map::MapSnapshot snapshot(int64_t utime = 0) const {
+    return map::encode_snapshot(map_.grid(), seq_, utime);
+  }
   // count_frontiers visits the whole map (a few ms for a house); MAP_STATS at 1 Hz can afford it.
   map::MapStats stats(bool count_frontiers = true) const;
 
@@ -73,7 +75,7 @@ class Mapper {
   DepthIntegrator integrator_;
   EsdfBuilder esdf_;
   int64_t seq_ = 0;
-  map::KeyBox esdf_dirty_;        // voxels changed since the last ESDF update
+  map::KeyBox esdf_dirty_;   // voxels changed since the last ESDF update
   bool esdf_stale_ = false;  // the whole map was replaced
   double esdf_ms_ = 0.0;
   double last_integrate_ms_ = 0.0;

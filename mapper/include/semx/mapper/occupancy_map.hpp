@@ -10,8 +10,8 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "semx/mapper/mapper_config.hpp"
 #include "semx/map/state_grid.hpp"
+#include "semx/mapper/mapper_config.hpp"
 
 namespace semx::mapper {
 
@@ -39,7 +39,9 @@ class OccupancyMap {
   // Whether updates may touch voxel k (always true without configured bounds).
   bool in_bounds(const map::VoxelKey& k) const { return !bounded_ || bounds_.contains(k); }
   // The updatable key box; empty optional when unbounded.
-  std::optional<map::KeyBox> bounds() const { return bounded_ ? std::optional<map::KeyBox>(bounds_) : std::nullopt; }
+  std::optional<map::KeyBox> bounds() const {
+    return bounded_ ? std::optional<map::KeyBox>(bounds_) : std::nullopt;
+  }
 
   map::VoxelState state(const map::VoxelKey& k) const { return grid_.state(k); }
   map::VoxelState state(const Eigen::Vector3d& p) const { return grid_.state(p); }
@@ -58,7 +60,8 @@ class OccupancyMap {
 
   // Batch path for the integrator: applies one observation to voxel i of block b and returns
   // the state before and after.
-  void apply(map::VoxelBlock& b, const map::VoxelKey& k, int i, bool hit, map::VoxelState& before, map::VoxelState& after) {
+  void apply(map::VoxelBlock& b, const map::VoxelKey& k, int i, bool hit, map::VoxelState& before,
+             map::VoxelState& after) {
     before = b.state[i];
     float l = b.log_odds[i] + (hit ? l_hit_ : l_miss_);
     if (l < l_min_) l = l_min_;

@@ -97,8 +97,8 @@ class DepStrategy : public Strategy {
   // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach. With
   // `sweep` a node is scored at the yaw whose turn from the vehicle's heading, counting what it
   // sweeps, scores best (GainConfig::sweep); otherwise at its best window.
-  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason, int64_t* unreachable = nullptr,
-                   bool sweep = false);
+  Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
+                   int64_t* unreachable = nullptr, bool sweep = false);
   // The paper's score (G + R_sem) / T_path (travel_cost.hpp).
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);
@@ -135,7 +135,7 @@ class DepStrategy : public Strategy {
   Roadmap graph_;
   int64_t root_ = -1;
   std::set<map::VoxelKey> changed_blocks_;  // since the last cycle
-  std::set<int64_t> reapproached_;             // passage nodes given approaches in this recovery
+  std::set<int64_t> reapproached_;          // passage nodes given approaches in this recovery
   // Voxels that became occupied or unknown since the last cycle, by block.
   std::map<map::VoxelKey, std::vector<map::VoxelKey>> obstacle_voxels_;
   bool full_reset_ = false;
@@ -143,7 +143,7 @@ class DepStrategy : public Strategy {
   Roadmap::Search search_;
   std::vector<double> reward_, cost_, score_, yaw_, view_gain_;
   mutable std::vector<double> sweeps_;  // scratch: one node's sweep gains
-  std::vector<double> region_factor_;  // one per region of ctx.regions this cycle
+  std::vector<double> region_factor_;   // one per region of ctx.regions this cycle
   // ctx.regions with the doors active when passage_weight is on (their factor says how much).
   std::vector<SemanticRegion> cycle_regions_;
 };

@@ -30,6 +30,7 @@
 #include <optional>
 #include <vector>
 
+#include "semx/core/random.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
@@ -37,7 +38,6 @@
 #include "semx/planner/gain_evaluator.hpp"
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/core/random.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/strategy.hpp"
 #include "semx/planner/voxel_set.hpp"

@@ -30,7 +30,7 @@ class FrontierTracker {
   bool contains(const map::VoxelKey& k) const { return frontier_.count(k) != 0; }
 
   struct Cluster {
-    map::VoxelKey cell;   // cell coordinates (floor(voxel centre / cluster_size))
+    map::VoxelKey cell;      // cell coordinates (floor(voxel centre / cluster_size))
     Eigen::Vector3d centre;  // mean of its frontier voxels' centres, m
     int64_t voxels = 0;
   };

@@ -9,9 +9,9 @@
 #include <algorithm>
 #include <vector>
 
+#include "semx/core/random.hpp"
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/core/random.hpp"
 
 namespace semx::planner {
 

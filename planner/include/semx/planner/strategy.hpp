@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/random.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
-#include "semx/core/random.hpp"
 #include "semx/planner/semantic_reward.hpp"
 #include "semx/planner/voxel_set.hpp"
 

@@ -5,9 +5,9 @@
 #include <Eigen/Core>
 #include <cstdint>
 
+#include "semx/core/random.hpp"
 #include "semx/runtime/config.hpp"
 #include "semx/simulator/quadrotor.hpp"
-#include "semx/core/random.hpp"
 
 namespace semx::simulator {
 

@@ -29,8 +29,8 @@
 namespace semx::evaluator {
 
 // The message contract's planner states (kUnknown: no PLANNER_STATUS heard yet).
-using core::PlannerState;
 using core::planner_state_from_int;
+using core::PlannerState;
 
 // Why a run ended.
 enum class Termination {
