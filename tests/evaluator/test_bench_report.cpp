@@ -20,7 +20,8 @@ std::string json_or_null(std::optional<double> v) { return v ? std::to_string(*v
 // One run folder as the evaluator writes it (the fields the report reads).
 void write_run(const std::string& root, const std::string& world, const std::string& planner, int seed,
                double time_f, std::optional<double> time_r, std::optional<double> time_o,
-               bool with_objects = true) {
+               bool with_objects = true, std::optional<double> time_95 = std::nullopt,
+               std::optional<double> end_game = std::nullopt) {
   const fs::path dir = fs::path(root) / (world + "-" + planner + "-s45-seed" + std::to_string(seed));
   fs::create_directories(dir);
   std::ofstream m(dir / "metrics.json");
@@ -28,6 +29,8 @@ void write_run(const std::string& root, const std::string& world, const std::str
     << ",\n  \"samples\": 45,\n  \"time_f_s\": " << time_f << ",\n  \"distance_m\": " << 2 * time_f
     << ",\n  \"coverage_pct\": 95,\n  \"time_r_s\": " << json_or_null(time_r) << ",\n";
   if (with_objects) m << "  \"object_coverage_pct\": 80,\n  \"time_o_s\": " << json_or_null(time_o) << ",\n";
+  if (time_95) m << "  \"time_95_s\": " << *time_95 << ",\n";
+  if (end_game) m << "  \"end_game_s\": " << *end_game << ",\n  \"time_settled_s\": " << time_f - *end_game << ",\n";
   m << "  \"collisions\": 0,\n  \"wall_s\": 10,\n  \"sim_s\": " << time_f
     << ",\n  \"termination\": \"planner_done\"\n}\n";
   std::ofstream c(dir / "coverage.csv");
@@ -70,8 +73,9 @@ TEST(BenchReport, TablesGiveMeansOverSeedsAndTheMarginsOfSemanticDep) {
   const std::string csv = bench_csv(runs);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-            "termination,dir,object_coverage_pct,time_o_s");
-  EXPECT_NE(csv.find(",80.000,30.000\n"), std::string::npos) << csv;
+            "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s");
+  // A run folder from before Time_95 and the end game leaves their columns empty.
+  EXPECT_NE(csv.find(",80.000,30.000,,,\n"), std::string::npos) << csv;
 }
 
 // Seed by seed: only seeds both reached 85 % in count; ties within 0.05 s are the same flight;
@@ -99,6 +103,30 @@ TEST(BenchReport, SeedBySeedComparisonCountsWinsAndGivesTheIntervalOfTheDifferen
       << md;
   EXPECT_NE(md.find("| env2 | aep | Time_o | 3 | 3 / 0 / 0 | -1.00 | [-1.00, -1.00] |"), std::string::npos)
       << md;
+}
+
+TEST(BenchReport, EveryPlannerIsDividedByTheOracleAndTheEndGameIsTabled) {
+  const std::string root = test::temp_dir("bench_report_oracle");
+  // oracle: Time_r 10, Time_95 20, distance 2 x 50 = 100 m. dep: Time_r 30, Time_95 50 (the mean of
+  // 40 and 60), distance 2 x 200 = 400 m.
+  write_run(root, "env2", "oracle", 1, 50, 10, std::nullopt, true, 20, 1);
+  write_run(root, "env2", "dep", 1, 200, 30, std::nullopt, true, 40, 100);
+  write_run(root, "env2", "dep", 2, 200, 30, std::nullopt, true, 60, 120);
+  write_run(root, "env2", "nbv", 1, 300, std::nullopt, std::nullopt, true);
+  const auto runs = load_bench_runs(root);
+  ASSERT_EQ(runs.size(), 4u);
+  const std::string md = bench_markdown(runs);
+  EXPECT_NE(md.find("| env2 | dep | 3.00 | 2.50 | 4.00 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | nbv | N/A | N/A | 6.00 |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("| env2 | oracle | N/A"), std::string::npos) << md;  // not divided by itself
+  // The comparison table ends with Time_95 and the end game.
+  EXPECT_NE(md.find("| 50.00 ± 14.14 | 110.00 ± 14.14 |"), std::string::npos) << md;
+  const std::string csv = bench_csv(runs);
+  EXPECT_NE(csv.find("time_95_s,time_settled_s,end_game_s\n"), std::string::npos);
+  EXPECT_NE(csv.find(",40.000,100.000,100.000\n"), std::string::npos) << csv;
+  // Without an oracle run there is no such table.
+  fs::remove_all(fs::path(root) / "env2-oracle-s45-seed1");
+  EXPECT_EQ(bench_markdown(load_bench_runs(root)).find("known-map oracle"), std::string::npos);
 }
 
 TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {

@@ -38,6 +38,38 @@ TEST(RunMetrics, TimeRBoundaryOnALargeTargetSet) {
   EXPECT_DOUBLE_EQ(*m.time_r_s(), 5.000001);
 }
 
+TEST(RunMetrics, Time95AndTheEndGameFromACoverageSeries) {
+  // 0 % to 96 % over 48 s (2 points a second), then 96.2 % at 60 s and 96.4 % at 100 s; DONE at
+  // 150 s. Final 96.4 %: settled at the first update within 0.5 points (>= 95.9 %): 96 % at 48 s.
+  RunMetrics m;
+  for (int i = 0; i <= 48; ++i) m.on_coverage(i * kS, 20 * i, 1000);
+  ASSERT_TRUE(m.time_95_s());
+  EXPECT_DOUBLE_EQ(*m.time_95_s(), 48.0);  // 95.0 % is reached at 47.5 s, i.e. the 48 s update
+  m.on_coverage(60 * kS, 962, 1000);
+  m.on_coverage(100 * kS, 964, 1000);
+  m.on_coverage(120 * kS, 964, 1000);  // no growth: does not move the settling time
+  m.on_planner_state(150 * kS, PlannerState::kDone);
+  m.finish(Termination::kPlannerDone, 151 * kS);
+  ASSERT_TRUE(m.time_settled_s());
+  EXPECT_DOUBLE_EQ(*m.time_settled_s(), 48.0);
+  ASSERT_TRUE(m.end_game_s());
+  EXPECT_DOUBLE_EQ(*m.end_game_s(), 150.0 - 48.0);
+  EXPECT_DOUBLE_EQ(*m.time_95_s(), 48.0);
+}
+
+TEST(RunMetrics, A95ThatIsNeverReachedIsNullAndASettledRunHasNoEndGame) {
+  RunMetrics none;
+  EXPECT_FALSE(none.time_settled_s());  // no coverage heard
+  EXPECT_FALSE(none.end_game_s());
+  RunMetrics m;
+  for (int i = 0; i <= 10; ++i) m.on_coverage(i * kS, 90 * i, 1000);  // up to 90 %, growing to the end
+  m.finish(Termination::kTimeLimit, 10 * kS, 10.0);
+  EXPECT_FALSE(m.time_95_s());
+  ASSERT_TRUE(m.time_settled_s());
+  EXPECT_DOUBLE_EQ(*m.time_settled_s(), 10.0);
+  EXPECT_DOUBLE_EQ(*m.end_game_s(), 0.0);
+}
+
 TEST(RunMetrics, TimeRIsNullWhenNeverReached) {
   RunMetrics m;
   for (int i = 0; i <= 10; ++i) m.on_coverage(i * kS, 80 * i, 1000);  // up to 80 %

@@ -20,7 +20,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep"};
+// The paper's rows, then the references: the FUEL-class baseline and the known-map oracle.
+const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "fuel", "oracle"};
+// The planner every other row is divided by in the "× oracle" table.
+const char* const kOraclePlanner = "oracle";
 
 int planner_rank(const std::string& p) {
   const auto it = std::find(kPlannerOrder.begin(), kPlannerOrder.end(), p);
@@ -191,6 +194,10 @@ BenchRun load_bench_run(const std::string& dir) {
   r.collisions = static_cast<int64_t>(number_of(m, "collisions", file));
   if (m["time_r_s"] && !m["time_r_s"].IsNull()) r.time_r_s = m["time_r_s"].as<double>();
   if (m["time_o_s"] && !m["time_o_s"].IsNull()) r.time_o_s = number_of(m, "time_o_s", file);
+  if (m["time_95_s"] && !m["time_95_s"].IsNull()) r.time_95_s = number_of(m, "time_95_s", file);
+  if (m["time_settled_s"] && !m["time_settled_s"].IsNull())
+    r.time_settled_s = number_of(m, "time_settled_s", file);
+  if (m["end_game_s"] && !m["end_game_s"].IsNull()) r.end_game_s = number_of(m, "end_game_s", file);
   if (m["object_coverage_pct"] && !m["object_coverage_pct"].IsNull())
     r.object_coverage_pct = number_of(m, "object_coverage_pct", file);
 
@@ -263,9 +270,11 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
   }
 
   md << "\n### Planners at " << o.comparison_samples << " samples, mean ± std over seeds\n\n"
+     << "Time_95: first time coverage ≥ 95 %; end game: Time_f minus the time the coverage came within "
+        "0.5 points of its final value (how long DONE came after the map stopped growing).\n\n"
      << "| Env. | Algorithm | seeds | Time_f (s) | Distance (m) | Coverage (%) | Time_r (s) | collisions | "
-        "Time_o (s) |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
+        "Time_o (s) | Time_95 (s) | End game (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& w : worlds) {
     std::vector<const BenchRun*> here;
     for (const auto& r : runs)
@@ -275,7 +284,42 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
       md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
          << " | " << pm(g.metric(&BenchRun::distance_m)) << " | " << pm(g.metric(&BenchRun::coverage_pct))
          << " | " << reached_time_cell(g, &BenchRun::time_r_s) << " | " << g.collisions() << " | "
-         << reached_time_cell(g, &BenchRun::time_o_s) << " |\n";
+         << reached_time_cell(g, &BenchRun::time_o_s) << " | " << reached_time_cell(g, &BenchRun::time_95_s)
+         << " | " << reached_time_cell(g, &BenchRun::end_game_s) << " |\n";
+    }
+  }
+
+  // Every planner against the physical limit: the oracle's means divide the others' (a mean over
+  // the seeds that reached the threshold, as in the table above).
+  bool any_oracle = false;
+  for (const auto& r : runs) any_oracle |= r.planner == kOraclePlanner && r.samples == o.comparison_samples;
+  if (any_oracle) {
+    md << "\n### Against the known-map oracle (× oracle: the planner's mean over the oracle's)\n\n"
+       << "| Env. | Algorithm | Time_r × oracle | Time_95 × oracle | Distance × oracle |\n"
+       << "|---|---|---|---|---|\n";
+    for (const auto& w : worlds) {
+      const Group oracle = select(runs, w, kOraclePlanner, o.comparison_samples);
+      if (oracle.runs.empty()) continue;
+      std::vector<const BenchRun*> here;
+      for (const auto& r : runs)
+        if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+      auto ratio_of = [&](const Group& g, std::optional<double> BenchRun::*field) {
+        int rg = 0, ro = 0;
+        const Stat sg = g.reached_time(field, &rg), so = oracle.reached_time(field, &ro);
+        if (rg == 0 || ro == 0 || !(so.mean > 0)) return std::string("N/A");
+        std::string cell = fmt(sg.mean / so.mean, 2);
+        if (rg < static_cast<int>(g.runs.size()))
+          cell += " (" + std::to_string(rg) + "/" + std::to_string(g.runs.size()) + ")";
+        return cell;
+      };
+      for (const auto& p : planners_of(here)) {
+        if (p == kOraclePlanner) continue;
+        const Group g = select(runs, w, p, o.comparison_samples);
+        const double od = oracle.metric(&BenchRun::distance_m).mean;
+        md << "| " << w << " | " << p << " | " << ratio_of(g, &BenchRun::time_r_s) << " | "
+           << ratio_of(g, &BenchRun::time_95_s) << " | "
+           << (od > 0 ? fmt(g.metric(&BenchRun::distance_m).mean / od, 2) : std::string("N/A")) << " |\n";
+      }
     }
   }
 
@@ -339,14 +383,17 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
 std::string bench_csv(const std::vector<BenchRun>& runs) {
   std::ostringstream c;
   c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-       "termination,dir,object_coverage_pct,time_o_s\n";
+       "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s\n";
   for (const auto& r : runs) {
     c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
       << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
       << (r.time_r_s ? fmt(*r.time_r_s, 3) : std::string()) << ',' << r.collisions << ',' << fmt(r.wall_s, 2)
       << ',' << fmt(r.sim_s, 3) << ',' << csv_escape(r.termination) << ',' << csv_escape(r.dir) << ','
       << (r.object_coverage_pct ? fmt(*r.object_coverage_pct, 3) : std::string()) << ','
-      << (r.time_o_s ? fmt(*r.time_o_s, 3) : std::string()) << '\n';
+      << (r.time_o_s ? fmt(*r.time_o_s, 3) : std::string()) << ','
+      << (r.time_95_s ? fmt(*r.time_95_s, 3) : std::string()) << ','
+      << (r.time_settled_s ? fmt(*r.time_settled_s, 3) : std::string()) << ','
+      << (r.end_game_s ? fmt(*r.end_game_s, 3) : std::string()) << '\n';
   }
   return c.str();
 }

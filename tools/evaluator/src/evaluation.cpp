@@ -109,6 +109,9 @@ RunSummary Evaluation::summary() const {
   s.distance_m = metrics_.distance_m();
   s.coverage_pct = metrics_.coverage_pct();
   s.time_r_s = metrics_.time_r_s();
+  s.time_95_s = metrics_.time_95_s();
+  s.time_settled_s = metrics_.time_settled_s();
+  s.end_game_s = metrics_.end_game_s();
   s.object_coverage_pct = metrics_.object_coverage_pct();
   s.time_o_s = metrics_.time_o_s();
   s.collisions = metrics_.collisions();

@@ -105,6 +105,9 @@ std::string metrics_json(const RunSummary& s) {
   field("distance_m", number(s.distance_m));
   field("coverage_pct", number(s.coverage_pct));
   field("time_r_s", json_optional(s.time_r_s));
+  field("time_95_s", json_optional(s.time_95_s));
+  field("time_settled_s", json_optional(s.time_settled_s));
+  field("end_game_s", json_optional(s.end_game_s));
   field("object_coverage_pct", number(s.object_coverage_pct));
   field("time_o_s", json_optional(s.time_o_s));
   field("collisions", std::to_string(s.collisions));
@@ -130,7 +133,8 @@ std::string metrics_json(const RunSummary& s) {
 
 std::string metrics_csv_header() {
   return "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,"
-         "termination,sim_s,resolution_m,target_voxels,covered_voxels,source,object_coverage_pct,time_o_s\n";
+         "termination,sim_s,resolution_m,target_voxels,covered_voxels,source,object_coverage_pct,time_o_s,"
+         "time_95_s,time_settled_s,end_game_s\n";
 }
 
 std::string metrics_csv_row(const RunSummary& s) {
@@ -141,7 +145,8 @@ std::string metrics_csv_row(const RunSummary& s) {
     << number(s.wall_s) << ',' << csv_field(s.termination) << ',' << number(s.sim_s) << ','
     << number(s.resolution_m) << ',' << s.target_voxels << ',' << s.covered_voxels << ','
     << csv_field(s.info.source) << ',' << number(s.object_coverage_pct) << ',' << csv_optional(s.time_o_s)
-    << '\n';
+    << ',' << csv_optional(s.time_95_s) << ',' << csv_optional(s.time_settled_s) << ','
+    << csv_optional(s.end_game_s) << '\n';
   return o.str();
 }
 
@@ -244,6 +249,11 @@ std::string format_metrics_table(const RunSummary& s) {
                       std::to_string(s.target_voxels) + " voxels at " + fmt("%g m)", s.resolution_m));
   const std::string tr = fmt("Time_r (%g %%)", s.coverage_threshold_pct);
   row(tr.c_str(), s.time_r_s ? fmt("%.2f s", *s.time_r_s) : std::string("N/A (never reached)"));
+  row("Time_95 (95 %)", s.time_95_s ? fmt("%.2f s", *s.time_95_s) : std::string("N/A (never reached)"));
+  if (s.time_settled_s && s.end_game_s) {
+    row("end game", fmt("%.2f s", *s.end_game_s) + "  (the map stopped growing at " +
+                        fmt("%.2f s", *s.time_settled_s) + ", within 0.5 points of its final coverage)");
+  }
   const std::string to = fmt("Time_o (%g %%)", s.object_threshold_pct);
   row("Objects", fmt("%.2f %%", s.object_coverage_pct) + "  (of " + std::to_string(s.object_voxels) +
                      " surface voxels of furniture)");

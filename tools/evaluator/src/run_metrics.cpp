@@ -74,6 +74,8 @@ void RunMetrics::on_coverage(int64_t utime, int64_t covered, int64_t target) {
   covered_ = covered;
   target_ = target;
   note_threshold(utime, covered, target, options_.coverage_threshold, time_r_utime_);
+  note_threshold(utime, covered, target, options_.high_threshold, time_95_utime_);
+  if (growth_.empty() || covered > growth_.back().second) growth_.emplace_back(utime, covered);
   note_time(utime);
 }
 
@@ -145,6 +147,28 @@ double RunMetrics::coverage_pct() const { return percent(covered_, target_); }
 std::optional<double> RunMetrics::time_r_s() const {
   if (!time_r_utime_) return std::nullopt;
   return seconds(*time_r_utime_);
+}
+
+std::optional<double> RunMetrics::time_95_s() const {
+  if (!time_95_utime_) return std::nullopt;
+  return seconds(*time_95_utime_);
+}
+
+std::optional<double> RunMetrics::time_settled_s() const {
+  if (growth_.empty() || target_ <= 0) return std::nullopt;
+  // The first update whose coverage is within settled_points of the final one (the last entry
+  // holds the final covered count).
+  const double final_pct = coverage_pct();
+  for (const auto& [utime, covered] : growth_) {
+    if (percent(covered, target_) >= final_pct - options_.settled_points) return seconds(utime);
+  }
+  return seconds(growth_.back().first);
+}
+
+std::optional<double> RunMetrics::end_game_s() const {
+  const std::optional<double> settled = time_settled_s();
+  if (!settled) return std::nullopt;
+  return std::max(0.0, time_f_s() - *settled);
 }
 
 std::optional<double> RunMetrics::planner_done_s() const {

@@ -20,6 +20,9 @@ struct BenchRun {
   double time_f_s = 0, distance_m = 0, coverage_pct = 0, wall_s = 0, sim_s = 0;
   std::optional<double> time_r_s;  // never reached 85 %
   std::optional<double> time_o_s;  // objects never 75 % covered, or a run folder from before it
+  std::optional<double> time_95_s;       // never reached 95 %, or a run folder from before it
+  std::optional<double> time_settled_s;  // coverage within 0.5 points of its final value
+  std::optional<double> end_game_s;      // time_f_s - time_settled_s
   std::optional<double> object_coverage_pct;
   int64_t collisions = 0;
   std::vector<std::pair<double, double>> coverage;  // (t s, %)
@@ -42,9 +45,10 @@ struct BenchReportOptions {
   double threshold_pct = 85.0;
 };
 
-// Markdown: the sweep table, the comparison table (with Time_o, the objects' 75 %, after the
-// paper's columns), and semantic-dep's margins over each baseline (Time_f, Time_r, Time_o,
-// Distance, in %), each world in the order the runs name them.
+// Markdown: the sweep table, the comparison table (with Time_95, the end game and Time_o, the
+// objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
+// the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
+// baseline (Time_f, Time_r, Time_o, Distance, in %), each world in the order the runs name them.
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
 // One row per run (the columns of metrics.csv plus the folder).
 std::string bench_csv(const std::vector<BenchRun>& runs);

@@ -6,6 +6,11 @@
 //   Distance   m, the sum of |p_i - p_(i-1)| over consecutive odometry positions;
 //   Coverage   %, the final coverage of the ground truth's target set;
 //   Time_r     s, the time of the first map update after which coverage >= 85 % (none if never);
+//   Time_95    s, the same at 95 %: how long the last rooms took, which 85 % does not see;
+//   Time_settled s, the first map update after which coverage was within 0.5 points of its final
+//              value: when the map stopped growing;
+//   End game   s, Time_f - Time_settled: how long DONE came after that (the tail a planner flies
+//              for nothing: unreachable frontiers, gains that never fall below the threshold);
 //   Time_o     s, the first time the objects' surfaces (CoverageTracker's object coverage: the
 //              furniture a semantic planner is meant to look at) are 75 % covered: their
 //              bottoms and backs keep the whole run below 90 % (env3 ends at 86 %);
@@ -22,6 +27,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "semx/core/states.hpp"
@@ -53,6 +59,8 @@ struct CoverageSample {
 
 struct MetricsOptions {
   double coverage_threshold = 0.85;  // Time_r: first time coverage >= this fraction
+  double high_threshold = 0.95;      // Time_95: the same, for the end of exploration
+  double settled_points = 0.5;       // Time_settled: within this many points of the final coverage
   double object_threshold = 0.75;    // Time_o: first time object coverage >= this fraction
   double sample_period_s = 1.0;      // coverage-over-time samples
   double trajectory_step_m = 0.02;   // trajectory points kept for pictures (>= this apart)
@@ -91,6 +99,11 @@ class RunMetrics {
   int64_t covered() const { return covered_; }
   int64_t target() const { return target_; }
   std::optional<double> time_r_s() const;
+  std::optional<double> time_95_s() const;
+  // Null before any coverage update; final only after finish().
+  std::optional<double> time_settled_s() const;
+  // time_f_s() - time_settled_s(), at least 0 (updates stamped after DONE still settle it).
+  std::optional<double> end_game_s() const;
   double object_coverage_pct() const;
   std::optional<double> time_o_s() const;
   int64_t collisions() const { return std::max(collision_events_, collision_count_); }
@@ -116,6 +129,10 @@ class RunMetrics {
   int64_t covered_ = 0;
   int64_t target_ = 0;
   std::optional<int64_t> time_r_utime_;
+  std::optional<int64_t> time_95_utime_;
+  // (utime, covered) at every update that covered more: coverage only grows (a known voxel stays
+  // known), so the settling time is found in it once the final value is known.
+  std::vector<std::pair<int64_t, int64_t>> growth_;
   int64_t object_covered_ = 0;
   int64_t object_target_ = 0;
   std::optional<int64_t> time_o_utime_;

@@ -29,6 +29,9 @@ struct RunSummary {
   double distance_m = 0.0;
   double coverage_pct = 0.0;
   std::optional<double> time_r_s;  // null when the threshold was never reached
+  std::optional<double> time_95_s;  // likewise, at 95 %
+  std::optional<double> time_settled_s;  // coverage within 0.5 points of its final value
+  std::optional<double> end_game_s;      // time_f_s - time_settled_s
   // The same over the objects' surfaces (coverage_tracker.hpp): what semantic-dep is for.
   double object_coverage_pct = 0.0;
   std::optional<double> time_o_s;
