@@ -233,6 +233,7 @@ void GainEvaluator::prepare(double res) {
   }
   const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
   seen_.assign((bits + 63) / 64, 0);
+  surface_.assign(seen_.size(), 0);
   // Blocks an offset can fall in, relative to the node's block, whatever the node's place in it.
   block_lo_ = (-hx_) >> map::kBlockBits;
   block_n_ = ((map::kBlockMask + hx_) >> map::kBlockBits) - block_lo_ + 1;
@@ -267,7 +268,9 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
     prepare(res);
   } else {
     std::memset(seen_.data(), 0, seen_.size() * sizeof(uint64_t));
+    if (config_.surface_occludes) std::memset(surface_.data(), 0, surface_.size() * sizeof(uint64_t));
   }
+  const bool occlude = config_.surface_occludes;
   const int nx = 2 * hx_ + 1;
   map::StateGrid::Reader neighbour_reader = grid.reader();
   const VoxelKey origin_block = map::block_of(origin);
@@ -320,7 +323,10 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
                                      static_cast<size_t>(nx) * static_cast<size_t>(it->dz + hz_));
       uint64_t& word = seen_[bit >> 6];
       const uint64_t mask = uint64_t{1} << (bit & 63);
-      if (word & mask) continue;
+      if (word & mask) {
+        if (occlude && (surface_[bit >> 6] & mask)) break;
+        continue;
+      }
       word |= mask;
       const VoxelKey k{origin.x + it->dx, origin.y + it->dy, origin.z + it->dz};
       const Eigen::Vector3d c = km.center(k) - p;
@@ -343,12 +349,18 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
           kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
         }
       }
+      if (occlude) {
+        // The kind decides whether the ray goes on, inside the sector or not.
+        if (!known_kind) known_kind = classify(neighbour_reader, k, kind);
+        if (kind == GainVoxel::kSurface) surface_[bit >> 6] |= mask;
+      }
       if (in_sector(c) && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li))) &&
           (known_kind || classify(neighbour_reader, k, kind))) {
         const int bin = bin_near(c, ray_bin);
         add(g, bin, kind);
         if (counted && in_window(bin)) counted->push_back(k);
       }
+      if (occlude && kind == GainVoxel::kSurface) break;
     }
   }
   if (stats) {

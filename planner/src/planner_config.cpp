@@ -100,6 +100,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   g.get("rays_elevation", c.gain.rays_elevation, 1, 100000);
   g.get("min_gain", c.gain.min_gain, 0.0, 1e12);
   g.get("sweep", c.gain.sweep);
+  g.get("surface_occludes", c.gain.surface_occludes);
   if (!(c.gain.min_range < c.gain.max_range)) g.fail("max_range", "must be above min_range");
   if (c.gain.rays_azimuth % c.gain.yaw_bins != 0) g.fail("rays_azimuth", "must be a multiple of yaw_bins");
 

@@ -210,7 +210,7 @@ TEST(BenchPlan, FlagErrorsNameTheFlag) {
   EXPECT_EQ(error_of({"--sweep", "30,x"}), "--sweep: 'x' is not a positive integer (or paper)");
   EXPECT_EQ(error_of({"--sweep", "0"}), "--sweep: '0' is not a positive integer (or paper)");
   EXPECT_EQ(error_of({"--worlds", "env1,/nonexistent/w.yaml"}),
-            "--worlds: '/nonexistent/w.yaml' is no world file (or env1, env2, env3)");
+            "--worlds: '/nonexistent/w.yaml' is no world file (or env1, env2, env3, generated)");
   // One message per command: the checks run in the bash bench's order.
   EXPECT_EQ(error_of({"--worlds", "/nonexistent", "--planners", "foo", "--seeds", "0"}),
             "--seeds '0': expected a positive integer");
@@ -235,7 +235,8 @@ TEST(BenchPlan, ListsSplitOnCommasAndBlanksAndExpandGlobs) {
   EXPECT_EQ(names(plan({"--worlds", d + "/b.yaml", "--planners", "dep", "--seeds", "1", "--sweep", "",
                         "--time-limits", "b=42"})),
             (std::vector<std::string>{"b-dep-s45-seed1 42"}));
-  EXPECT_EQ(error_of({"--worlds", d}), "--worlds: '" + d + "' is no world file (or env1, env2, env3)");
+  EXPECT_EQ(error_of({"--worlds", d}),
+            "--worlds: '" + d + "' is no world file (or env1, env2, env3, generated)");
   fs::remove_all(d);
 }
 
@@ -244,6 +245,34 @@ TEST(BenchPlan, HelpIsTheBenchsUsage) {
   EXPECT_EQ(h.rfind("usage: ./semx bench [--worlds LIST]", 0), 0u);
   EXPECT_NE(h.find("--dry-run prints the runs in the order they\nwould start"), std::string::npos);
   EXPECT_EQ(h.back(), '\n');
+}
+
+TEST(BenchPlan, GeneratedIsAFixedSetOfEightWorldsFrom50To600SquareMetres) {
+  const auto& g = generated_worlds();
+  ASSERT_EQ(g.size(), 8u);
+  EXPECT_EQ(g.front().area_m2, 50);
+  EXPECT_EQ(g.back().area_m2, 600);
+  EXPECT_EQ(g.front().rooms, 1);
+  EXPECT_EQ(g.back().rooms, 14);
+  for (std::size_t i = 1; i < g.size(); ++i) EXPECT_GT(g[i].area_m2, g[i - 1].area_m2);
+  EXPECT_EQ(g[0].name(), "generated-s1-a50-r1");
+
+  BenchOptions o =
+      parse_bench_args({"--worlds", "env1,generated", "--planners", "dep", "--seeds", "1", "--sweep", ""});
+  validate_bench_options(o);
+  EXPECT_EQ(generated_worlds_of(o).size(), 8u);
+  const auto runs = bench_runs(o, "/out/worlds");
+  ASSERT_EQ(runs.size(), 9u);
+  // Longest limits first: the 600 m² world's 1500 s, ..., env1's 300 s last.
+  EXPECT_EQ(runs.front().world, "/out/worlds/generated-s8-a600-r14.yaml");
+  EXPECT_EQ(runs.front().time_limit, "1500");
+  EXPECT_EQ(runs.back().name(), "env1-dep-s45-seed1");
+  // --time-limits names a generated world, or "*" all of them.
+  o.time_limits = "generated-s1-a50-r1=42,*=100";
+  for (const auto& r : bench_runs(o, "w")) {
+    EXPECT_EQ(r.time_limit, r.world == "w/generated-s1-a50-r1.yaml" ? "42" : "100") << r.world;
+  }
+  EXPECT_TRUE(generated_worlds_of(parse_bench_args({"--worlds", "env1"})).empty());
 }
 
 }  // namespace

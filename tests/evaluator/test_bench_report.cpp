@@ -30,7 +30,8 @@ void write_run(const std::string& root, const std::string& world, const std::str
     << ",\n  \"coverage_pct\": 95,\n  \"time_r_s\": " << json_or_null(time_r) << ",\n";
   if (with_objects) m << "  \"object_coverage_pct\": 80,\n  \"time_o_s\": " << json_or_null(time_o) << ",\n";
   if (time_95) m << "  \"time_95_s\": " << *time_95 << ",\n";
-  if (end_game) m << "  \"end_game_s\": " << *end_game << ",\n  \"time_settled_s\": " << time_f - *end_game << ",\n";
+  if (end_game)
+    m << "  \"end_game_s\": " << *end_game << ",\n  \"time_settled_s\": " << time_f - *end_game << ",\n";
   m << "  \"collisions\": 0,\n  \"wall_s\": 10,\n  \"sim_s\": " << time_f
     << ",\n  \"termination\": \"planner_done\"\n}\n";
   std::ofstream c(dir / "coverage.csv");

@@ -66,6 +66,26 @@ double sort_key(const std::string& s) {
 
 }  // namespace
 
+std::string GeneratedWorld::name() const {
+  return "generated-s" + std::to_string(seed) + "-a" + std::to_string(area_m2) + "-r" + std::to_string(rooms);
+}
+
+const std::vector<GeneratedWorld>& generated_worlds() {
+  // Areas roughly evenly on a log scale, rooms growing with them; time limits 300 s + 2 s per m²
+  // (DEP took ~1.3 s per m² to DONE in env1-3).
+  static const std::vector<GeneratedWorld> worlds = {
+      {1, 50, 1, "400"},  {2, 90, 3, "480"},    {3, 140, 4, "580"},   {4, 200, 6, "700"},
+      {5, 280, 8, "860"}, {6, 380, 10, "1060"}, {7, 480, 12, "1260"}, {8, 600, 14, "1500"},
+  };
+  return worlds;
+}
+
+std::vector<GeneratedWorld> generated_worlds_of(const BenchOptions& o) {
+  for (const auto& w : list_words(o.worlds))
+    if (w == kGeneratedWorlds) return generated_worlds();
+  return {};
+}
+
 const std::vector<std::string>& reserved_launch_args() {
   static const std::vector<std::string> keys = {"world", "planner",    "seed", "samples",
                                                 "clock", "time_limit", "out",  "progress"};
@@ -145,8 +165,8 @@ void validate_bench_options(const BenchOptions& o) {
     }
   }
   for (const auto& w : list_words(o.worlds)) {
-    if (!is_shipped_world(w) && !is_regular_file(w)) {
-      throw ArgError("--worlds: '" + w + "' is no world file (or env1, env2, env3)");
+    if (!is_shipped_world(w) && w != kGeneratedWorlds && !is_regular_file(w)) {
+      throw ArgError("--worlds: '" + w + "' is no world file (or env1, env2, env3, generated)");
     }
   }
 }
@@ -226,13 +246,23 @@ std::string BenchRun::name() const {
   return world_name(world) + "-" + planner + "-s" + samples + "-seed" + std::to_string(seed);
 }
 
-std::vector<BenchRun> bench_runs(const BenchOptions& o) {
+std::vector<BenchRun> bench_runs(const BenchOptions& o, const std::string& generated_dir) {
   struct World {
     std::string path, limit;
     double key;
   };
   std::vector<World> worlds;
+  const std::string text = "," + o.time_limits + ",";
   for (const auto& w : list_words(o.worlds)) {
+    if (w == kGeneratedWorlds) {
+      for (const GeneratedWorld& g : generated_worlds()) {
+        std::string limit = last_value(text, g.name());
+        if (limit.empty()) limit = last_value(text, "*");
+        if (limit.empty()) limit = g.time_limit;
+        worlds.push_back({generated_dir + "/" + g.name() + ".yaml", limit, sort_key(limit)});
+      }
+      continue;
+    }
     const std::string limit = time_limit_of(o.time_limits, w);
     worlds.push_back({w, limit, sort_key(limit)});
   }
@@ -277,6 +307,8 @@ DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has metrics
 run again, so an interrupted bench continues where it stopped. At the end semx-bench-report
 writes DIR/tables.md (mean ± std over seeds, the paper's layout), DIR/results.csv and
 DIR/coverage_WORLD.png (every planner on one plot per world).
+--worlds generated: eight generated apartments of 50 to 600 m² and 1 to 14 rooms (semx-world gen,
+seeds 1-8, written to DIR/worlds/), time limits 300 s + 2 s per m² unless --time-limits names them.
 Time limits (simulated s): env1=300, env2=600, env3=900 by default. --logs keeps each run's
 LCM log (about 100 MB per run). --jobs N runs N process sets at once, each on its own LCM
 port (a lockstep set leaves part of the machine idle while it waits for acks; the metrics do not

@@ -45,9 +45,8 @@ int main(int argc, char** argv) {
       return 0;
     }
     bench::validate_bench_options(o);
-    const auto runs = bench::bench_runs(o);
     if (o.dry_run) {
-      std::cout << bench::dry_run_text(runs);
+      std::cout << bench::dry_run_text(bench::bench_runs(o));
       return 0;
     }
     const double t0 = bench::steady_now_s();
@@ -58,6 +57,20 @@ int main(int argc, char** argv) {
       throw runtime::ArgError("--out '" + out + "': cannot create the directory");
     }
     out = fs::canonical(out).string();
+    // The generated worlds, written once per output folder (a continued bench reuses them).
+    const std::string worlds_dir = out + "/worlds";
+    for (const bench::GeneratedWorld& g : bench::generated_worlds_of(o)) {
+      const std::string file = worlds_dir + "/" + g.name() + ".yaml";
+      if (fs::exists(file)) continue;
+      fs::create_directories(worlds_dir, ec);
+      const std::string cmd = "'" + runtime::executable_dir() + "/semx-world' gen --seed " +
+                              std::to_string(g.seed) + " --area " + std::to_string(g.area_m2) + " --rooms " +
+                              std::to_string(g.rooms) + " --out '" + file + ".tmp' > /dev/null";
+      if (std::system(cmd.c_str()) != 0 || std::rename((file + ".tmp").c_str(), file.c_str()) != 0) {
+        throw std::runtime_error("cannot generate '" + file + "' (" + cmd + ")");
+      }
+    }
+    const auto runs = bench::bench_runs(o, worlds_dir);
 
     const int jobs = bench::job_count(o);
     std::cout << "semx: bench: " << runs.size() << " runs into " << out

@@ -126,6 +126,7 @@ class GainEvaluator {
   int block_lo_ = 0, block_lo_z_ = 0, block_n_ = 0;
   // Scratch: one bit per voxel of the box around the node, "already counted".
   std::vector<uint64_t> seen_;
+  std::vector<uint64_t> surface_;  // seen_ voxels that are surface voxels (surface_occludes)
   const VoxelSet* ignored_ = nullptr;
   double seen_res_ = 0.0;
   int hx_ = 0, hz_ = 0;

@@ -98,15 +98,21 @@ struct GainConfig {
   double weight_unknown = 1.0;
   double weight_frontier = 2.0;
   double weight_surface = 4.0;
-  int yaw_bins = 32;        // azimuth histogram (DEP)
-  int rays_azimuth = 128;   // gain rays around the node (a multiple of yaw_bins)
-  int rays_elevation = 10;  // rays across the vertical field of view
+  int yaw_bins = 32;         // azimuth histogram (DEP)
+  int rays_azimuth = 128;    // gain rays around the node (a multiple of yaw_bins)
+  int rays_elevation = 10;   // rays across the vertical field of view
   double min_gain = 1000.0;  // a node with G below this is not a goal (weighted voxels)
   // An ablation (docs/planner.md, "Gain"): DEP's score counts what the turn to a node's yaw
   // sweeps, not only the final window, and takes the yaw that scores best that way. false (the
   // default): the best window's gain and yaw, DEP's definition. Eligibility (min_gain) and
   // termination use the best window either way.
   bool sweep = false;
+  // Unknown space does not occlude (DEP's optimistic assumption), except behind a surface voxel
+  // (unknown, next to free and to occupied space): a ray that reaches one counts it and stops,
+  // because what lies behind an object's unseen surface is mostly the object's inside, which no
+  // view observes (docs/planner.md, "The end game"). false: DEP's model, every unknown voxel up to
+  // the first occupied one counts.
+  bool surface_occludes = false;
 
   double horizontal_fov() const;  // rad
   double vertical_fov() const;    // rad

@@ -40,7 +40,7 @@ BenchOptions parse_bench_args(const std::vector<std::string>& args);
 
 // The checks after parsing, in the order of the bash bench (so one command gives one message):
 // --seeds, --samples, --jobs positive integers, --planners known, --sweep positive integers,
-// --worlds env1..3 or files. Throws runtime::ArgError.
+// --worlds env1..3, "generated" or files. Throws runtime::ArgError.
 void validate_bench_options(const BenchOptions& o);
 
 // --seeds and --jobs as numbers (after validate_bench_options).
@@ -63,6 +63,21 @@ std::string time_limit_of(const std::string& time_limits, const std::string& wor
 // env1 and env2 25..45, env3 30..50, any other world 25..50.
 std::string sweep_of(const std::string& sweep, const std::string& world);
 
+// `--worlds generated`: a fixed set of generated apartments (semx-world gen) from 50 to 600 m² and
+// 1 to 14 rooms, the same for everyone who runs it: nobody tuned a planner to them, and they
+// span the sizes env1-3 do not. semx-bench writes them to DIR/worlds/NAME.yaml before the runs
+// (the generator is deterministic per seed, so the files are the same on every machine).
+struct GeneratedWorld {
+  int seed = 0;
+  int area_m2 = 0;
+  int rooms = 0;
+  std::string time_limit;    // simulated s when --time-limits names neither it nor "*"
+  std::string name() const;  // generated-sSEED-aAREA-rROOMS, the generator's own world name
+};
+const std::vector<GeneratedWorld>& generated_worlds();
+// The word of --worlds that stands for them.
+inline constexpr const char* kGeneratedWorlds = "generated";
+
 struct BenchRun {
   std::string world;  // as given: env1 or a path
   std::string planner;
@@ -79,7 +94,11 @@ struct BenchRun {
 // alone on a half-idle machine; per world and seed the comparison (--planners at --samples),
 // then semantic-dep at the rest of the world's sweep (its --samples entry is the comparison's
 // run when semantic-dep is compared).
-std::vector<BenchRun> bench_runs(const BenchOptions& o);
+// `generated_dir` is where the generated worlds' files are (or will be) written.
+std::vector<BenchRun> bench_runs(const BenchOptions& o, const std::string& generated_dir = "worlds");
+
+// The generated worlds a plan needs (those of `--worlds generated`), in their order.
+std::vector<GeneratedWorld> generated_worlds_of(const BenchOptions& o);
 
 // "[K/TOTAL] NAME: time limit S s", one line per run: what --dry-run prints.
 std::string dry_run_text(const std::vector<BenchRun>& runs);
