@@ -500,8 +500,15 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     cost_[i] = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
   };
 
-  using Item = std::pair<double, int64_t>;  // (score, -id): ties go to the lower id
+  // (near tier, score, -id): with cost.local_first, every node that near outranks the rest; ties
+  // go to the lower id.
+  using Item = std::tuple<int, double, int64_t>;
   std::priority_queue<Item> queue;
+  const double local = config_.cost.local_first;
+  auto push = [&](double s, int64_t id) {
+    const double d = search_.distance[static_cast<size_t>(id)];
+    queue.emplace(local > 0 && d <= local ? 1 : 0, s, -id);
+  };
   int64_t reachable = 0;
   const double min_gain = config_.gain.min_gain;
   for (const RoadmapNode& n : graph_.slots()) {
@@ -512,7 +519,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     rate(n.id);
     if (m.blacklisted_until >= ctx.cycle || m.passage) continue;
     if (m.gain.gain < min_gain || nothing_to_do(ctx, n.id, yaw_[static_cast<size_t>(n.id)])) continue;
-    queue.emplace(score_[static_cast<size_t>(n.id)], -n.id);
+    push(score_[static_cast<size_t>(n.id)], n.id);
   }
   Goal goal;
   // A path through a doorway holds the heading of travel there (hold_heading_through_doorways),
@@ -522,7 +529,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   // is never higher, so the best left is still found first.
   std::set<int64_t> turn_checked;
   while (!queue.empty()) {
-    const int64_t id = -queue.top().second;
+    const int64_t id = -std::get<2>(queue.top());
     queue.pop();
     RoadmapNode& n = graph_.node(id);
     std::optional<FlownPath> f;  // the winner's path, when the turn check built it
@@ -539,7 +546,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
         if (flown < score_[i] - 1e-9) {
           score_[i] = flown;
           cost_[i] = travel_time(search_.distance[i], turn, config_.cost);
-          queue.emplace(flown, -id);
+          push(flown, id);
           continue;
         }
       }
@@ -548,7 +555,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
       evaluate_gain(ctx, id);
       rate(id);
       const size_t i = static_cast<size_t>(id);
-      if (n.gain.gain >= min_gain && !nothing_to_do(ctx, id, yaw_[i])) queue.emplace(score_[i], -id);
+      if (n.gain.gain >= min_gain && !nothing_to_do(ctx, id, yaw_[i])) push(score_[i], id);
       continue;
     }
     goal.valid = true;

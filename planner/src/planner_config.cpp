@@ -110,6 +110,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   k.get("yaw_weight", c.cost.yaw_weight, 0.0, 1e6);
   k.get("min_time", c.cost.min_time, 1e-6, 1e6);
   k.get("turn_while_flying", c.cost.turn_while_flying);
+  k.get("local_first", c.cost.local_first);
 
   auto rw = m.child("reward");
   rw.get("unexplored_weight", c.reward.unexplored_weight, 0.0, 1e3);

@@ -219,7 +219,15 @@ int main(int argc, char** argv) {
         if (run == 0) std::printf("oracle_interior_voxels: %zu\n", keys.size());
       }
       ExplorationSim sim(*world, planner, o);
+      int64_t known_at_path = 0;
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
+        if (verbose && out.path) {
+          // What the goal just left behind added to the map: a goal's promise against its yield.
+          const int64_t known = sim.known().known_voxels();
+          std::printf("path t=%.2f grew=%lld known=%lld\n", t, static_cast<long long>(known - known_at_path),
+                      static_cast<long long>(known));
+          known_at_path = known;
+        }
         if (verbose && out.status && out.status->iteration > 0) {
           const StatusReport& s = *out.status;
           std::printf(
@@ -250,6 +258,9 @@ int main(int argc, char** argv) {
         ++objects_done;
       }
       std::printf("run_time_to_85: %.1f s\n", r.time_85);
+      std::printf("run_time_to_95: %.1f s\n", r.time_95);
+      std::printf("run_end_game: %.1f s of %.1f s (settled at %.1f s, coverage %.2f %%)\n",
+                  r.time_s - r.time_settled, r.time_s, r.time_settled, 100.0 * r.coverage);
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
         ++reached_85;
@@ -259,6 +270,8 @@ int main(int argc, char** argv) {
       collisions += r.collisions;
       paths += r.paths;
       done += r.done ? 1 : 0;
+      if (verbose)
+        for (const auto& [t, cov] : r.coverage_curve) std::printf("coverage t=%.1f %.3f %%\n", t, 100.0 * cov);
       if (verbose)
         std::printf("run %lld: %s after %.1f s: %s\n", static_cast<long long>(run),
                     r.done ? "DONE" : "stopped", r.time_s, r.reason.c_str());

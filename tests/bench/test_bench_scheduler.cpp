@@ -61,7 +61,7 @@ fi
 [ "$planner" = aep ] && exit 3
 [ "$planner" = nbv ] && kill -INT "$PPID"
 printf 'world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s\nenv1,%s,1,45,32.47,19.12,98.76,,0,5.9\n' "$planner" > "$out/metrics.csv"
-echo '{}' > "$out/metrics.json"
+printf '{"termination": "%s"}\n' "${TERMINATION:-planner_done}" > "$out/metrics.json"
 )sh";
 
 SchedulerOptions fake_options(const std::string& root) {
@@ -181,6 +181,34 @@ TEST(BenchScheduler, RunsEachPlanEntryAndKeepsWhatIsDone) {
   std::ostringstream logs;
   run_bench({runs[0]}, o, logs, steady_now_s());
   EXPECT_TRUE(fs::exists(o.out_dir + "/runs/env1-dep-s45-seed1/run.lcmlog"));
+  fs::remove_all(root);
+}
+
+TEST(BenchScheduler, ARunStoppedBeforeItsEndRunsAgainAndWhatItLeftIsKeptAside) {
+  const std::string root = temp_dir("stopped");
+  SchedulerOptions o = fake_options(root);
+  const std::vector<BenchRun> runs = {{"env1", "dep", "45", 1, "300"}};
+  setenv("TERMINATION", "stopped", 1);
+  std::ostringstream first;
+  EXPECT_EQ(run_bench(runs, o, first, steady_now_s()), 0);
+  unsetenv("TERMINATION");
+  const std::string dir = o.out_dir + "/runs/env1-dep-s45-seed1";
+  std::ofstream(dir + "/mine") << "x";
+
+  std::ostringstream again;
+  EXPECT_EQ(run_bench(runs, o, again, steady_now_s()), 0);
+  const auto l = lines(again.str());
+  ASSERT_EQ(l.size(), 2u) << again.str();
+  const std::string aside = o.out_dir + "/interrupted/env1-dep-s45-seed1-1";
+  EXPECT_EQ(l[0], "[1/1] env1-dep-s45-seed1: stopped before its end last time, run again (moved to " + aside + ")");
+  EXPECT_EQ(l[1].rfind("[1/1] env1-dep-s45-seed1: coverage 98.8 %", 0), 0u) << l[1];
+  EXPECT_EQ(read(aside + "/mine"), "x");  // nothing the stopped run left is lost
+  EXPECT_FALSE(fs::exists(dir + "/mine"));
+
+  // Finished now: kept.
+  std::ostringstream third;
+  EXPECT_EQ(run_bench(runs, o, third, steady_now_s()), 0);
+  EXPECT_EQ(lines(third.str())[0], "[1/1] env1-dep-s45-seed1: done before, kept");
   fs::remove_all(root);
 }
 

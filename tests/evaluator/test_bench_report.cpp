@@ -48,6 +48,8 @@ TEST(BenchReport, TablesGiveMeansOverSeedsAndTheMarginsOfSemanticDep) {
   write_run(root, "env1", "dep", 2, 200, 40, std::nullopt);  // objects never at 75 %
   // nbv never reaches 85 %, and its folders come from before object coverage.
   write_run(root, "env1", "nbv", 1, 50, std::nullopt, std::nullopt, false);
+  // What semx-bench set aside when it ran a stopped run again is not read.
+  write_run(root + "/interrupted", "env1", "dep", 1, 999, 1, 1);
   const auto runs = load_bench_runs(root);
   ASSERT_EQ(runs.size(), 5u);
   for (const auto& r : runs) EXPECT_EQ(r.object_coverage_pct.has_value(), r.planner != "nbv") << r.dir;

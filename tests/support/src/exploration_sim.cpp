@@ -153,6 +153,11 @@ ExplorationSimResult ExplorationSim::run(
   r.coverage = world_.coverage(known_);
   r.coverage_curve.emplace_back(r.time_s, r.coverage);
   if (r.time_85 < 0 && r.coverage >= 0.85) r.time_85 = r.time_s;
+  // As the evaluator defines them (run_metrics.hpp), on this loop's coverage samples.
+  for (const auto& [t, c] : r.coverage_curve) {
+    if (r.time_95 < 0 && c >= 0.95) r.time_95 = t;
+    if (r.time_settled < 0 && c >= r.coverage - 0.005) r.time_settled = t;
+  }
   if (!r.done) r.reason = planner_.last_status().reason;
   return r;
 }

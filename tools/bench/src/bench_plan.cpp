@@ -303,8 +303,10 @@ The paper's experiment, in LOCKSTEP (deterministic per seed): for every world an
 default, "paper", is the table's rows: env1 and env2 at 25,30,35,40,45, env3 at 30,35,40,45,50,
 a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep) at
 --samples (default 45). Each run is ./semx demo's process set writing a run folder under
-DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has metrics.json is not
-run again, so an interrupted bench continues where it stopped. At the end semx-bench-report
+DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has the metrics of a run
+that ended (DONE, time limit) is not run again, so an interrupted bench continues where it
+stopped; one that was stopped before its end runs again, its old folder moved to
+DIR/interrupted/ (not in the tables). At the end semx-bench-report
 writes DIR/tables.md (mean ± std over seeds, the paper's layout), DIR/results.csv and
 DIR/coverage_WORLD.png (every planner on one plot per world).
 --worlds generated: eight generated apartments of 50 to 600 m² and 1 to 14 rooms (semx-world gen,

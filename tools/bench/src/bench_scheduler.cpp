@@ -24,6 +24,34 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// True when metrics.json says the run ended as a run ends (DONE, the time limit or the episode's
+// end), not stopped or still running: the evaluator writes the file on a Ctrl-C too.
+bool run_finished(const std::string& metrics) {
+  std::ifstream in(metrics);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string s = text.str();
+  const std::size_t key = s.find("\"termination\"");
+  if (key == std::string::npos) return false;
+  const std::size_t open = s.find('"', s.find(':', key));
+  if (open == std::string::npos) return false;
+  const std::size_t close = s.find('"', open + 1);
+  const std::string value = s.substr(open + 1, close == std::string::npos ? 0 : close - open - 1);
+  return value == "planner_done" || value == "time_limit" || value == "episode_end";
+}
+
+// Moves DIR/runs/NAME to the first free DIR/interrupted/NAME-K and returns that path.
+std::string set_aside(const std::string& out_dir, const std::string& name) {
+  fs::create_directories(out_dir + "/interrupted");
+  for (int k = 1;; ++k) {
+    const std::string to = out_dir + "/interrupted/" + name + "-" + std::to_string(k);
+    if (!fs::exists(to)) {
+      fs::rename(out_dir + "/runs/" + name, to);
+      return to;
+    }
+  }
+}
+
 // SIGINT and SIGCHLD wake the scheduler through this pipe, so it can block in poll() without a
 // signal slipping in between a check and the wait.
 int g_wake[2] = {-1, -1};
@@ -332,9 +360,16 @@ int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std:
   for (int k = 1; k <= total && !SignalScope::interrupted(); ++k) {
     const BenchRun& run = runs[static_cast<std::size_t>(k - 1)];
     // Checked when the run's turn comes, before a slot is free: what an interrupted bench left.
-    if (is_regular_file(o.out_dir + "/runs/" + run.name() + "/metrics.json")) {
-      say(run_tag(k, total, run.name()) + ": done before, kept");
-      continue;
+    const std::string dir = o.out_dir + "/runs/" + run.name();
+    if (is_regular_file(dir + "/metrics.json")) {
+      if (run_finished(dir + "/metrics.json")) {
+        say(run_tag(k, total, run.name()) + ": done before, kept");
+        continue;
+      }
+      // A run cut short (Ctrl-C, a killed set) wrote metrics.json too; it is run again, and what
+      // it left is kept aside where the report does not read it.
+      const std::string aside = set_aside(o.out_dir, run.name());
+      say(run_tag(k, total, run.name()) + ": stopped before its end last time, run again (moved to " + aside + ")");
     }
     int slot = -1;
     while (true) {

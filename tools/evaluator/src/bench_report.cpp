@@ -222,6 +222,11 @@ std::vector<BenchRun> load_bench_runs(const std::string& root) {
   std::vector<std::string> dirs;
   std::error_code ec;
   for (fs::recursive_directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+    // semx-bench keeps runs it had to start again under DIR/interrupted/: not part of the tables.
+    if (it->is_directory() && it->path().filename() == "interrupted") {
+      it.disable_recursion_pending();
+      continue;
+    }
     if (it->is_regular_file() && it->path().filename() == "metrics.json")
       dirs.push_back(it->path().parent_path().string());
   }

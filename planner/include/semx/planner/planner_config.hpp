@@ -129,6 +129,11 @@ struct CostConfig {
   // longer of the two, 85 % coverage came 18-23 % earlier in env2 and env3 over ten seeds
   // (docs/planner.md, "Travel cost and score"). false: the paper's sum.
   bool turn_while_flying = true;
+  // m of path: while any eligible node lies within this path distance of the vehicle, DEP
+  // chooses among those only (best score first) and looks farther only once they are done, so
+  // small leftovers near the vehicle are finished before it leaves them behind (the end game:
+  // docs/planner.md). 0: the paper's rule, the best score anywhere.
+  double local_first = 0.0;
 };
 
 // The semantic reward R_sem (semantic_reward.hpp); only semantic-dep uses it.
