@@ -510,7 +510,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     queue.emplace(local > 0 && d <= local ? 1 : 0, s, -id);
   };
   int64_t reachable = 0;
-  const double min_gain = config_.gain.min_gain;
+  const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
   for (const RoadmapNode& n : graph_.slots()) {
     if (!n.alive || !search_.reached(n.id)) continue;
     ++reachable;
@@ -643,7 +643,7 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   }
   RoadmapNode& n = graph_.node(goal.node);
   if (n.gain_stale || !n.gain.valid) evaluate_gain(ctx, goal.node);
-  if (n.gain.gain < config_.gain.min_gain) return std::nullopt;
+  if (n.gain.gain < std::max(config_.gain.min_gain, ctx.min_gain)) return std::nullopt;
   const double reward = reward_at(ctx, n.position, goal.yaw);
   // The goal keeps the yaw it was chosen with (its best yaw may have moved since); with the sweep
   // it is worth what the rest of the turn to that yaw sweeps.

@@ -36,6 +36,8 @@ void ExplorationPlanner::reset() {
   last_status_ = StatusReport();
   unobservable_.clear();
   arrived_utime_ = short_since_ = -1;
+  yields_.clear();
+  open_known_ = -1;
   if (grid_) frontiers_.reset(*grid_);
   strategy_->on_map_reset();
 }
@@ -128,6 +130,30 @@ void ExplorationPlanner::mark_unobservable(CycleCounters& c) {
   c.rays += stats.rays;
   c.ray_steps += stats.steps;
   c.gain_ms += w.ms();
+}
+
+void ExplorationPlanner::open_yield(double gain) {
+  if (config_.loop.yield_goals <= 0 || !grid_) return;
+  open_promise_ = gain;
+  open_known_ = grid_->known_voxels();
+}
+
+void ExplorationPlanner::close_yield() {
+  if (open_known_ < 0 || !grid_) return;
+  yields_.push_back({open_promise_, grid_->known_voxels() - open_known_});
+  while (yields_.size() > static_cast<size_t>(config_.loop.yield_goals)) yields_.pop_front();
+  open_known_ = -1;
+}
+
+double ExplorationPlanner::min_gain_now() const {
+  const double base = config_.gain.min_gain;
+  if (config_.loop.yield_goals <= 0 || yields_.size() < static_cast<size_t>(config_.loop.yield_goals)) return base;
+  double promised = 0, delivered = 0;
+  for (const Yield& y : yields_) promised += y.promised, delivered += static_cast<double>(y.delivered);
+  // Delivery is counted in voxels and the gain in weighted voxels (a surface voxel counts 4):
+  // while goals deliver at least what they promised the threshold is DEP's own.
+  const double ratio = promised > 0 ? std::clamp(delivered / promised, 1e-3, 1.0) : 1.0;
+  return base / ratio;
 }
 
 bool ExplorationPlanner::path_blocked() const {
@@ -242,6 +268,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
   ctx.unobservable = &unobservable_;
   ctx.cycle = iteration_;
   ctx.recovering = no_goal_cycles_ > 0;
+  ctx.min_gain = min_gain_now();
   ctx.rng = &rng_;
   ctx.counters = &c;
 
@@ -315,6 +342,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
       p.goal.yaws = {pose_->yaw};
     }
     goal_ = Goal();  // nothing to fly
+    close_yield();
     ++no_goal_cycles_;
     const int limit = o.unreachable_informative > 0
                           ? std::max(config_.loop.done_cycles, config_.loop.max_recovery_cycles)
@@ -358,6 +386,8 @@ void ExplorationPlanner::release(Output& out, int64_t utime) {
       }
     } else {
       goal_ = p.goal;  // invalid for a hold: the next cycle plans again
+      close_yield();
+      if (goal_.valid) open_yield(goal_.gain);
       controller_holding_ = false;
       arrived_utime_ = short_since_ = -1;
       PlannedPath path;

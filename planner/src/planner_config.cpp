@@ -110,7 +110,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   k.get("yaw_weight", c.cost.yaw_weight, 0.0, 1e6);
   k.get("min_time", c.cost.min_time, 1e-6, 1e6);
   k.get("turn_while_flying", c.cost.turn_while_flying);
-  k.get("local_first", c.cost.local_first);
+  k.get("local_first", c.cost.local_first, 0.0, 1e6);
 
   auto rw = m.child("reward");
   rw.get("unexplored_weight", c.reward.unexplored_weight, 0.0, 1e3);
@@ -128,6 +128,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("blacklist_cycles", c.loop.blacklist_cycles, 0, 1000000);
   l.get("visited_cycles", c.loop.visited_cycles, 0, 1000000);
   l.get("max_start_offset", c.loop.max_start_offset, 0.0, 100.0);
+  l.get("yield_goals", c.loop.yield_goals, 0, 1000);
 
   auto ch = m.child("charge");
   ch.get("base_s", c.charge.base_s, 0.0, 1e3);

@@ -214,6 +214,22 @@ TEST_F(LogEvalTest, TheWorldComesFromEpisodeStart) {
   const simulator::GroundTruth env1(simulator::load_world(simulator::shipped_world_path("env1")), 0.1);
   EXPECT_EQ(ev.evaluation().tracker().target_count(), static_cast<int64_t>(env1.target_count()));
 
+  // Another world given for this log is refused, naming both, unless asked for.
+  o.world = "env3";
+  try {
+    LogEvaluator refused(o);
+    ADD_FAILURE() << "env3 accepted for a log of env1";
+  } catch (const LogEvalError& e) {
+    EXPECT_NE(std::string(e.what()).find("the log's world is 'env1'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not 'env3'"), std::string::npos) << e.what();
+  }
+  o.any_world = true;
+  EXPECT_EQ(LogEvaluator(o).evaluation().options().info.world, "env3");
+  o.world = "env1";  // the same world given is fine
+  o.any_world = false;
+  EXPECT_EQ(LogEvaluator(o).evaluation().options().info.world, "env1");
+  o.world.clear();
+
   const std::string anonymous = dir_ + "/anon.lcmlog";
   write_log(anonymous, {test::scene_event(ch::PLANNER_STATUS, test::planner_status(0, 0))});
   o.log_path = anonymous;

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
     std::string log, world, out, planner;
     int64_t seed = -1, samples = -1;
     double time_limit = 0, resolution = 0.1, sample_period = 1.0;
+    bool any_world = false;
     runtime::ArgParser p("semx-eval",
                          "Computes a run's metrics (coverage against the ground truth, Time_f, Distance,\n"
                          "Time_r at 85 %, collisions) from an lcm-logger log of it, with no network, and\n"
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
                 "world file or env1/env2/env3 (default: the one the log's "
                 "EPISODE_START names)",
                 &world)
+        .flag("any-world", "evaluate against --world even when the log names another world", &any_world)
         .option("out", "DIR", "run folder to write (default: none, only the table)", &out)
         .option("time-limit", "S", "end the run after S simulated seconds (default: the log's end)",
                 &time_limit)
@@ -44,6 +46,7 @@ int main(int argc, char** argv) {
     evaluator::LogEvalOptions o;
     o.log_path = log;
     o.world = world;
+    o.any_world = any_world;
     o.evaluation.info.planner = planner;
     if (seed >= 0) o.evaluation.info.seed = seed;
     if (samples >= 0) o.evaluation.info.samples = samples;

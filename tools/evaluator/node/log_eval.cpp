@@ -97,8 +97,9 @@ LogEvaluator::LogEvaluator(LogEvalOptions options) : options_(std::move(options)
     throw LogEvalError(e.what());
   }
   std::string world = options_.world;
+  const std::string logged = world_named_in_log(options_.log_path, report_.layout);
   if (world.empty()) {
-    world = world_named_in_log(options_.log_path, report_.layout);
+    world = logged;
     if (world.empty()) {
       throw LogEvalError(options_.log_path +
                          ": the log names no world (no SIM_EVENT EPISODE_START); give it with --world");
@@ -106,6 +107,11 @@ LogEvaluator::LogEvaluator(LogEvalOptions options) : options_(std::move(options)
   }
   world_path_ = resolve_world(world);
   simulator::World w = simulator::load_world(world_path_);
+  if (!logged.empty() && !w.name.empty() && w.name != logged && !options_.any_world) {
+    throw LogEvalError(options_.log_path + ": the log's world is '" + logged + "' (SIM_EVENT EPISODE_START), not '" +
+                       w.name + "' (" + world_path_ + "); give --world " + logged +
+                       " or --any-world to evaluate against this one anyway");
+  }
   EvaluationOptions eo = options_.evaluation;
   if (eo.info.world.empty()) eo.info.world = w.name.empty() ? world_stem(world_path_) : w.name;
   if (eo.info.world_path.empty()) eo.info.world_path = world_path_;

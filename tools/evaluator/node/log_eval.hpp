@@ -30,6 +30,10 @@ struct LogEvalOptions {
   std::string log_path;
   // World file or shipped name; "" takes the name the simulator gave in SIM_EVENT EPISODE_START.
   std::string world;
+  // A given world whose name differs from the one the log's EPISODE_START names is refused (the
+  // coverage of one world's log against another's truth is a number that means nothing), unless
+  // this is set.
+  bool any_world = false;
   EvaluationOptions evaluation;  // info (planner, seed, samples), time limit, resolution
 };
 

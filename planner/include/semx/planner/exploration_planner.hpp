@@ -26,6 +26,7 @@
 // left by more than loop.max_start_offset by then is dropped and replanned at once.
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -146,6 +147,18 @@ class ExplorationPlanner {
   bool init_reported_ = false;
   Pending pending_;
   StatusReport last_status_;
+  // What the goals flown lately delivered (loop.yield_goals): per goal, the gain it was chosen
+  // with and the voxels the map gained while it was flown.
+  struct Yield {
+    double promised = 0;
+    int64_t delivered = 0;
+  };
+  std::deque<Yield> yields_;
+  double open_promise_ = 0;
+  int64_t open_known_ = -1;  // known voxels when the goal being flown was released; -1: none
+  void open_yield(double gain);
+  void close_yield();
+  double min_gain_now() const;
 };
 
 }  // namespace semx::planner

@@ -176,6 +176,11 @@ struct LoopConfig {
   // goal before the goal is given up (and blacklisted): a vehicle that cannot get there (its
   // commands rejected, a body that does not fit) would otherwise wait for it forever.
   double short_hold_s = 3.0;
+  // Goals that do not deliver (docs/planner.md, "The end game"): the share of their gain that the
+  // last this many goals delivered (voxels the map gained while each was flown, over the gain it
+  // was chosen with; at most 1) scales every node's gain before min_gain is applied, so when the
+  // gains left stop turning into map the planner ends instead of touring them. 0: off.
+  int yield_goals = 0;
 };
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").

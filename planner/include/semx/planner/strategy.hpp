@@ -29,7 +29,10 @@ struct PlanContext {
   // Voxels that gains ignore (seen as unobservable after a visit; exploration_planner.hpp).
   const VoxelSet* unobservable = nullptr;
   int64_t cycle = 0;
-  bool recovering = false;  // the previous cycles found no goal: sample for frontiers
+  bool recovering = false;
+  // The gain a goal must have: gain.min_gain, raised by the main loop when recent goals delivered
+  // less than their gain promised (loop.yield_goals).
+  double min_gain = 0.0;  // the previous cycles found no goal: sample for frontiers
   core::SplitMixRng* rng = nullptr;
   CycleCounters* counters = nullptr;
 };
