@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
@@ -396,4 +397,23 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   EXPECT_EQ(player.wait(10), 0) << read_file(temp_path("replay.out"));
   ASSERT_EQ(ticks.size(), 50u);
   for (int i = 0; i < 50; ++i) EXPECT_EQ(ticks[static_cast<std::size_t>(i)], i);
+
+  // A file that is not a log is refused, not "played" with exit 0.
+  const std::string junk = temp_path("junk.lcmlog");
+  std::ofstream(junk) << "not an LCM log";
+  Process bad({"/bin/bash", semx_cmd, "replay", junk, "--lcm-url", url}, temp_path("replay-bad.out"));
+  EXPECT_NE(bad.wait(30), 0) << read_file(temp_path("replay-bad.out"));
+  EXPECT_NE(read_file(temp_path("replay-bad.out")).find("not a whole LCM log"), std::string::npos)
+      << read_file(temp_path("replay-bad.out"));
+}
+
+TEST(Processes, SemxDemoKeepsARunFolderThatIsThere) {
+  const std::string semx_cmd = std::string(SEMX_SOURCE_DIR) + "/semx";
+  const std::string dir = temp_path("kept-run");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/metrics.json") << "{}";
+  Process demo({"/bin/bash", semx_cmd, "demo", "--out", dir}, temp_path("demo-kept.out"));
+  EXPECT_EQ(demo.wait(30), 2) << read_file(temp_path("demo-kept.out"));
+  EXPECT_NE(read_file(temp_path("demo-kept.out")).find("--force"), std::string::npos);
+  EXPECT_EQ(read_file(dir + "/metrics.json"), "{}");
 }
