@@ -56,6 +56,17 @@ std::string msg_vec(const Eigen::Vector3d& v) {
   return buf;
 }
 
+// Why these bounds are more than a world may hold (world.hpp), or "".
+std::string bounds_too_large(const Aabb& b) {
+  if (!b.min.allFinite() || !b.max.allFinite()) return "must be finite";
+  const Eigen::Vector3d e = b.max - b.min;
+  if (e.maxCoeff() > kMaxWorldExtent)
+    return "span " + msg_vec(e) + " m: at most " + num(kMaxWorldExtent) + " m on each axis";
+  if (e.prod() > kMaxWorldVolume)
+    return "hold " + num(e.prod()) + " m³: at most " + num(kMaxWorldVolume) + " m³";
+  return "";
+}
+
 using WhereFn = std::function<std::string(size_t)>;
 
 // Checks shared by the parser and validate_world; `where_solid` / `where_start` locate the
@@ -189,6 +200,7 @@ World parse_world(const std::string& text, const std::string& source) {
   w.bounds.max = get_vec3(bounds, "max", true);
   if ((w.bounds.max.array() <= w.bounds.min.array()).any())
     bounds.fail("max", "must exceed min on every axis");
+  if (const std::string why = bounds_too_large(w.bounds); !why.empty()) bounds.fail("max", why);
 
   if (!root.has("start")) root.fail("start", "is required");
   ConfigMap start = root.child("start");
@@ -200,6 +212,8 @@ World parse_world(const std::string& text, const std::string& source) {
   if (!root.has("solids")) root.fail("solids", "is required");
   std::vector<ConfigMap> maps = root.children("solids");
   if (maps.empty()) root.fail("solids", "a world needs at least one solid");
+  if (maps.size() > kMaxWorldSolids)
+    root.fail("solids", std::to_string(maps.size()) + " solids, at most " + std::to_string(kMaxWorldSolids));
   for (auto& m : maps) w.solids.push_back(read_solid(m));
   root.finish();
 
@@ -230,6 +244,10 @@ void validate_world(World& world) {
     }
   }
   if ((world.bounds.max.array() <= world.bounds.min.array()).any()) throw WorldError(src + ": empty bounds");
+  if (const std::string why = bounds_too_large(world.bounds); !why.empty()) throw WorldError(src + ": bounds " + why);
+  if (world.solids.size() > kMaxWorldSolids)
+    throw WorldError(src + ": " + std::to_string(world.solids.size()) + " solids, at most " +
+                     std::to_string(kMaxWorldSolids));
   check_and_assign(
       world, [&](size_t i) { return src + ": solid " + std::to_string(i); }, src + ": start");
 }

@@ -112,6 +112,9 @@ TEST(WorldParse, EachBadInputNamesFileAndLine) {
        "w.yaml:8:", "instance 7 is a chair here but a table at w.yaml:7:"},
       {"empty bounds", bad("max: [4.2, 3.2, 2.8]", "max: [4.2, -3.2, 2.8]"), "w.yaml:2:", "must exceed min"},
       {"yaml syntax", bad("solids:", "solids: ["), "w.yaml:", "YAML syntax error"},
+      // What no process could voxelise: named with the line, never std::bad_alloc or a crash.
+      {"huge bounds", bad("max: [4.2, 3.2, 2.8]", "max: [1e300, 3.2, 2.8]"), "w.yaml:2:", "at most 200 m"},
+      {"too much volume", bad("max: [4.2, 3.2, 2.8]", "max: [150, 150, 12]"), "w.yaml:2:", "m³"},
   };
   for (const auto& c : cases) {
     const std::string msg = error_of(c.text);
@@ -130,6 +133,9 @@ TEST(WorldParse, ValidateWorldChecksBuiltWorlds) {
   EXPECT_NO_THROW(validate_world(w));
   w.solids.push_back(
       Solid::box(SemanticClass::kChair, {2, 1.5, 3.0}, {0.4, 0.4, 0.8}));  // through the ceiling
+  EXPECT_THROW(validate_world(w), WorldError);
+  w.solids.pop_back();
+  w.bounds.max.x() = 1e6;
   EXPECT_THROW(validate_world(w), WorldError);
 }
 

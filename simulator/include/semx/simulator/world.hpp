@@ -35,6 +35,14 @@ struct World {
 
 using WorldError = runtime::ConfigError;
 
+// What a world may hold: every process voxelises it at the map's resolution (0.1 m) and the
+// ground truth floods its free space, so a box of ±1e6 m is std::bad_alloc, not a world. 200 m
+// a side and 2e5 m³ (2e8 voxels at 0.1 m: a 2 GB ground truth at most) leave every indoor scene
+// room; 1e5 solids is 20× the largest generated world.
+constexpr double kMaxWorldExtent = 200.0;   // m, each axis of the bounds
+constexpr double kMaxWorldVolume = 2.0e5;   // m³, the bounds' volume
+constexpr size_t kMaxWorldSolids = 100000;
+
 // Reads a world file; throws WorldError "file:line:col: ..." on any malformed input.
 World load_world(const std::string& file);
 World parse_world(const std::string& text, const std::string& source);
