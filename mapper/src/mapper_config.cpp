@@ -10,6 +10,7 @@ namespace {
 // The per-frame scratch grid spans the view frustum; this keeps it below 2^27 cells.
 constexpr double kMaxRangeInVoxels = 250.0;
 constexpr double kMaxEsdfCells = 8.0e6;
+constexpr double kMaxBoundVoxels = 30000.0;
 }  // namespace
 
 void load(runtime::ConfigMap& m, MapperConfig& c) {
@@ -84,6 +85,12 @@ void validate(const OccupancyParams& o) {
       invalid("occupancy.bounds_* need 3 numbers (x y z)");
     for (int i = 0; i < 3; ++i) {
       if (!(o.bounds_min[i] < o.bounds_max[i])) invalid("occupancy.bounds_min must be below bounds_max");
+      // OctoMap's keys (map.bt, checkpoints) are 16 bits around the origin: a bound beyond them
+      // (±1e9 m) wrapped every voxel and the run reported 0 % and DONE at 2 s.
+      const double limit = kMaxBoundVoxels * o.resolution;
+      if (!(std::abs(o.bounds_min[i]) <= limit && std::abs(o.bounds_max[i]) <= limit))
+        invalid("occupancy.bounds_* must lie within ±" + std::to_string(static_cast<int64_t>(limit)) +
+                " m (30000 voxels of the resolution: OctoMap's 16-bit keys)");
     }
   }
 }

@@ -65,6 +65,7 @@ TEST(Config, RejectsTyposAndNonsense) {
   expect_error("occupancy: {clamp_min: 0.45, threshold: 0.4}", "clamp_min < threshold");
   expect_error("occupancy: {bounds_min: [0, 0, 0]}", "go together");
   expect_error("occupancy: {bounds_min: [0, 0, 0], bounds_max: [1, -1, 1]}", "below");
+  expect_error("occupancy: {bounds_min: [-1e9, -1e9, 0], bounds_max: [1e9, 1e9, 3]}", "within ±3000 m");
   expect_error("integration: {min_range: 6}", "min_range");
   expect_error("integration: {mode: quick}", "not one of");
   expect_error("resolution: 0.01\nintegration: {max_range: 5}", "scratch");
