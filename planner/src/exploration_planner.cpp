@@ -67,7 +67,21 @@ void ExplorationPlanner::set_pose(const VehiclePose& pose) {
 }
 
 void ExplorationPlanner::on_controller_status(ControllerState state, int64_t plan_id) {
-  if (!goal_.valid || plan_id != plan_id_) return;  // about a plan we no longer fly
+  if (!goal_.valid) return;
+  if (plan_id != plan_id_) {
+    // A plan id this planner never sent (ids count up from 1): the controller took someone else's
+    // path, so ours is not flown any more. Once it rejected or stopped on that path, the vehicle
+    // hovers: plan again from where it is (a foreign NaN path or one into a wall froze a run for
+    // its whole time limit). Our own earlier plans are history and are ignored.
+    const bool foreign = plan_id <= 0 || plan_id > plan_id_;
+    if (foreign && !controller_trigger_ &&
+        (state == ControllerState::kRejected || state == ControllerState::kBraking)) {
+      controller_trigger_ = true;
+      controller_rejected_ = false;  // nothing wrong with our goal
+      controller_reason_ = "controller stopped on a path this planner did not send";
+    }
+    return;
+  }
   controller_holding_ = state == ControllerState::kHolding;
   if (state == ControllerState::kBraking || state == ControllerState::kStaleInput ||
       state == ControllerState::kRejected) {

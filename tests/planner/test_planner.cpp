@@ -378,14 +378,30 @@ TEST(Planner, ReplansWhenTheControllerRejectsAndAvoidsThatGoal) {
   auto& [g, p, t, first] = start;
   ASSERT_TRUE(first);
   const Goal rejected = p.goal();
-  // A stale status about another plan changes nothing.
-  p.on_controller_status(ControllerState::kRejected, first->plan_id + 7);
   p.on_controller_status(ControllerState::kRejected, first->plan_id);
   const auto second = first_path(p, t + 10000, t + 2000000);
   ASSERT_TRUE(second);
   EXPECT_EQ(second->plan_id, first->plan_id + 1);
   EXPECT_NE(p.goal().node, rejected.node);
   EXPECT_NE(p.last_status().reason.find("controller rejected"), std::string::npos) << p.last_status().reason;
+}
+
+TEST(Planner, ReplansWhenTheControllerStopsOnAPathItDidNotSend) {
+  CorridorStart start;
+  auto& [g, p, t, first] = start;
+  ASSERT_TRUE(first);
+  // Tracking someone else's path says nothing yet; a stop on it leaves the vehicle hovering, and
+  // the planner plans again (before, it waited EXECUTING until the time limit).
+  p.on_controller_status(ControllerState::kTracking, first->plan_id + 7);
+  EXPECT_FALSE(first_path(p, t + 10000, t + 1000000)) << "nothing to replan for yet";
+  p.on_controller_status(ControllerState::kRejected, first->plan_id + 7);
+  const auto second = first_path(p, t + 1000000, t + 3000000);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->plan_id, first->plan_id + 1);
+  EXPECT_NE(p.last_status().reason.find("did not send"), std::string::npos) << p.last_status().reason;
+  // A status about one of its own earlier plans is history: nothing happens.
+  p.on_controller_status(ControllerState::kRejected, first->plan_id);
+  EXPECT_FALSE(first_path(p, t + 3000000, t + 4000000));
 }
 
 TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
