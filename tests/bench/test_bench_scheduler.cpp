@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "semx/bench/bench_scheduler.hpp"
+#include "semx/runtime/args.hpp"
 
 namespace semx::bench {
 namespace {
@@ -84,9 +85,9 @@ std::vector<std::string> lines(const std::string& text) {
 }
 
 TEST(BenchScheduler, LaunchArgumentsAndOnePortPerSlot) {
-  EXPECT_EQ(slot_lcm_url(7667, 0), "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
-  EXPECT_EQ(slot_lcm_url(7667, 3), "udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304");
   SchedulerOptions o;
+  EXPECT_EQ(slot_lcm_url(o.base_url, 0), "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(slot_lcm_url(o.base_url, 3), "udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304");
   o.launch_args = {"semantics_config=a.yaml"};
   const BenchRun run{"env2", "dep", "30", 2, "600"};
   EXPECT_EQ(launch_argv(run, 1, "/o/runs/env2-dep-s30-seed2", o),
@@ -210,6 +211,20 @@ TEST(BenchScheduler, ARunStoppedBeforeItsEndRunsAgainAndWhatItLeftIsKeptAside) {
   EXPECT_EQ(run_bench(runs, o, third, steady_now_s()), 0);
   EXPECT_EQ(lines(third.str())[0], "[1/1] env1-dep-s45-seed1: done before, kept");
   fs::remove_all(root);
+}
+
+TEST(BenchScheduler, SlotUrlsFollowTheBaseUrl) {
+  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304", 2),
+            "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=4194304");
+  // LCM_DEFAULT_URL as docs showed it: the receive buffer the bench needs is added.
+  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7711?ttl=0", 0), "udpm://239.255.76.67:7711?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.68:7711", 1), "udpm://239.255.76.68:7712?recv_buf_size=4194304");
+  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7711?recv_buf_size=8388608&ttl=0", 0, 9000),
+            "udpm://239.255.76.67:9000?recv_buf_size=8388608&ttl=0");
+  EXPECT_THROW(slot_lcm_url("memq://", 0), runtime::ArgError);
+  EXPECT_THROW(slot_lcm_url("udpm://239.255.76.67", 0), runtime::ArgError);
+  EXPECT_THROW(slot_lcm_url("udpm://239.255.76.67:76x7", 0), runtime::ArgError);
+  EXPECT_THROW(slot_lcm_url("udpm://239.255.76.67:65535", 1), runtime::ArgError);
 }
 
 TEST(BenchScheduler, SlotsRunAtOnceEachOnItsPort) {

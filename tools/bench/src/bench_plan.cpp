@@ -131,6 +131,8 @@ BenchOptions parse_bench_args(const std::vector<std::string>& args) {
       o.launch_args.push_back(kv);
     } else if (a == "--jobs") {
       o.jobs = value("--jobs needs a number");
+    } else if (a == "--base-port") {
+      o.base_port = value("--base-port needs a port");
     } else if (a == "--quick") {
       o.worlds = "env1";
       o.seeds = "1";
@@ -154,6 +156,11 @@ void validate_bench_options(const BenchOptions& o) {
     throw ArgError("--samples '" + o.samples + "': expected a positive integer");
   }
   if (!positive_integer(o.jobs)) throw ArgError("--jobs '" + o.jobs + "': expected a positive integer");
+  if (!o.base_port.empty() &&
+      (!positive_integer(o.base_port) || o.base_port.size() > 5 || std::stoi(o.base_port) < 1024 ||
+       std::stoi(o.base_port) + std::stoi(o.jobs) - 1 > 65535)) {
+    throw ArgError("--base-port '" + o.base_port + "': expected a port from 1024 with --jobs ports free above it");
+  }
   for (const auto& p : list_words(o.planners)) {
     if (std::find(kPlanners.begin(), kPlanners.end(), p) == kPlanners.end()) {
       throw ArgError("--planners: unknown planner '" + p + "'");
@@ -314,7 +321,9 @@ seeds 1-8, written to DIR/worlds/), time limits 300 s + 2 s per m² unless --tim
 Time limits (simulated s): env1=300, env2=600, env3=900 by default. --logs keeps each run's
 LCM log (about 100 MB per run). --jobs N runs N process sets at once, each on its own LCM
 port (a lockstep set leaves part of the machine idle while it waits for acks; the metrics do not
-depend on it, only the wall times do). --arg KEY=VALUE goes to every run's process set
+depend on it, only the wall times do): slot k talks on LCM_DEFAULT_URL (default
+udpm://239.255.76.67:7667?ttl=0) with its port + k, or on --base-port P + k; recv_buf_size=4194304
+is added when the URL has none. --arg KEY=VALUE goes to every run's process set
 (tools/launch/demo.yaml), e.g. --arg semantics_config=FILE or --arg planner_config=FILE for an
 ablation. --quick: env1, one seed, no sweep, 120 s. --dry-run prints the runs in the order they
 would start (the worlds with the longest time limit first) and their time limits, and runs nothing.

@@ -18,6 +18,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "semx/runtime/args.hpp"
+
 namespace semx::bench {
 
 namespace fs = std::filesystem;
@@ -194,8 +196,29 @@ double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string slot_lcm_url(int base_port, int slot) {
-  return "udpm://239.255.76.67:" + std::to_string(base_port + slot) + "?ttl=0&recv_buf_size=4194304";
+std::string slot_lcm_url(const std::string& base_url, int slot, int port) {
+  const std::string scheme = "udpm://";
+  const std::size_t q = base_url.find('?');
+  const std::string address = base_url.substr(0, q);
+  std::string opts = q == std::string::npos ? "" : base_url.substr(q + 1);
+  const std::size_t colon = address.rfind(':');
+  if (address.rfind(scheme, 0) != 0 || colon == std::string::npos || colon < scheme.size()) {
+    throw runtime::ArgError("LCM URL '" + base_url + "': the bench needs udpm://ADDRESS:PORT (one port per slot)");
+  }
+  int base = port;
+  if (base < 0) {
+    const std::string digits = address.substr(colon + 1);
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 5) {
+      throw runtime::ArgError("LCM URL '" + base_url + "': '" + digits + "' is not a port");
+    }
+    base = std::stoi(digits);
+  }
+  if (base + slot > 65535) {
+    throw runtime::ArgError("LCM port " + std::to_string(base) + " + slot " + std::to_string(slot) + " is past 65535");
+  }
+  if (("&" + opts).find("&recv_buf_size=") == std::string::npos)
+    opts += (opts.empty() ? "" : "&") + std::string("recv_buf_size=4194304");
+  return address.substr(0, colon + 1) + std::to_string(base + slot) + "?" + opts;
 }
 
 std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::string& dir,
@@ -204,7 +227,7 @@ std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::s
   // Without logs, no logger either: it reads every message of the run only to write a log the
   // bench would delete.
   if (!o.keep_logs) argv.insert(argv.end(), {"--without", "logger"});
-  argv.insert(argv.end(), {"--no-color", "--lcm-url", slot_lcm_url(o.base_port, slot)});
+  argv.insert(argv.end(), {"--no-color", "--lcm-url", slot_lcm_url(o.base_url, slot)});
   for (const std::string& a :
        {"world=" + run.world, "planner=" + run.planner, "seed=" + std::to_string(run.seed),
         "samples=" + run.samples, "clock=" + o.clock, "time_limit=" + run.time_limit, "out=" + dir,

@@ -16,6 +16,7 @@
 #include "semx/bench/bench_plan.hpp"
 #include "semx/bench/bench_scheduler.hpp"
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/lcm_url.hpp"
 #include "semx/runtime/executable_dir.hpp"
 
 using namespace semx;
@@ -82,6 +83,10 @@ int main(int argc, char** argv) {
     so.keep_logs = o.keep_logs;
     so.clock = o.clock;
     so.launch_args = o.launch_args;
+    so.base_url = bench::slot_lcm_url(runtime::resolve_lcm_url(""), 0,
+                                      o.base_port.empty() ? -1 : std::stoi(o.base_port));
+    std::cout << "semx: bench: slot 1 on " << so.base_url
+              << (jobs > 1 ? " (slot k on its port + k - 1)" : "") << std::endl;
     if (const char* snmp = std::getenv("SEMX_SNMP"); snmp && *snmp) so.snmp_path = snmp;
     if (bench::run_bench(runs, so, std::cout, t0) == 130) {
       std::cout << "semx: bench interrupted; run it again with --out " << out << " to continue" << std::endl;

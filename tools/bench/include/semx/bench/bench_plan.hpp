@@ -25,6 +25,7 @@ struct BenchOptions {
   bool keep_logs = false;
   std::string clock = "lockstep";
   std::string jobs = "1";
+  std::string base_port;  // "": the port of LCM_DEFAULT_URL (else 7667); slot k uses it + k
   bool dry_run = false;
   bool help = false;                     // --help was given: print bench_help() and nothing else
   std::vector<std::string> launch_args;  // --arg KEY=VALUE, to every run's process set
