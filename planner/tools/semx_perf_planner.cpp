@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
                 &semantic_weight)
         .option("coverage-period", "S",
                 "simulated seconds between coverage samples, the resolution of "
-                "run_time_to_85 (default 1)",
+                "run_time_to_85 and run_time_to_95 (default 1)",
                 &coverage_period)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
@@ -188,8 +188,8 @@ int main(int argc, char** argv) {
 
     std::vector<double> cycle_cpu_ms, cycle_ms, sample_ms, connect_ms, gain_ms, search_ms, charged_ms, evals;
     std::vector<CycleCounters> counters;
-    double coverage = 0, time_s = 0, distance = 0, time_85 = 0, objects_time = 0;
-    int64_t reached_85 = 0, objects_done = 0, objects_completed = 0;
+    double coverage = 0, time_s = 0, distance = 0, time_85 = 0, time_95 = 0, objects_time = 0;
+    int64_t reached_85 = 0, reached_95 = 0, objects_done = 0, objects_completed = 0;
     int64_t collisions = 0, done = 0, paths = 0;
     const auto wall0 = std::chrono::steady_clock::now();
     for (int64_t run = 0; run < runs; ++run) {
@@ -254,6 +254,14 @@ int main(int argc, char** argv) {
         time_85 += r.time_85;
         ++reached_85;
       }
+      std::printf("run_time_to_95: %.1f s\n", r.time_95);
+      std::printf("run_coverage: %.2f %%\n", 100.0 * r.coverage);
+      std::printf("run_collisions: %lld steps\n", static_cast<long long>(r.collisions));
+      std::printf("run_end: %s at %.1f s\n", r.done ? "DONE" : "stopped", r.time_s);
+      if (r.time_95 >= 0) {
+        time_95 += r.time_95;
+        ++reached_95;
+      }
       time_s += r.time_s;
       distance += r.distance;
       collisions += r.collisions;
@@ -288,6 +296,7 @@ int main(int argc, char** argv) {
     std::printf("done: %lld explorations\n", static_cast<long long>(done));
     std::printf("exploration_time: %.1f s\n", time_s / n);
     if (reached_85 > 0) std::printf("time_to_85: %.1f s\n", time_85 / static_cast<double>(reached_85));
+    if (reached_95 > 0) std::printf("time_to_95: %.1f s\n", time_95 / static_cast<double>(reached_95));
     std::printf("distance: %.1f m\n", distance / n);
     if (semantic_weight > 0) {
       std::printf("objects_total: %zu objects\n", world->objects().size());

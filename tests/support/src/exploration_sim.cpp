@@ -139,6 +139,7 @@ ExplorationSimResult ExplorationSim::run(
       const double c = world_.coverage(known_);
       r.coverage_curve.emplace_back(t, c);
       if (r.time_85 < 0 && c >= 0.85) r.time_85 = t;
+      if (r.time_95 < 0 && c >= 0.95) r.time_95 = t;
       next_coverage += options_.coverage_period;
     }
     if (on_step) on_step(t, out);
@@ -153,6 +154,7 @@ ExplorationSimResult ExplorationSim::run(
   r.coverage = world_.coverage(known_);
   r.coverage_curve.emplace_back(r.time_s, r.coverage);
   if (r.time_85 < 0 && r.coverage >= 0.85) r.time_85 = r.time_s;
+  if (r.time_95 < 0 && r.coverage >= 0.95) r.time_95 = r.time_s;
   if (!r.done) r.reason = planner_.last_status().reason;
   return r;
 }

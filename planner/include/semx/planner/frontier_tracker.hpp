@@ -28,6 +28,8 @@ class FrontierTracker {
 
   size_t size() const { return frontier_.size(); }
   bool contains(const map::VoxelKey& k) const { return frontier_.count(k) != 0; }
+  // Every frontier voxel (unordered: callers that decide on them sort first).
+  const std::unordered_set<map::VoxelKey>& voxels() const { return frontier_; }
 
   struct Cluster {
     map::VoxelKey cell;      // cell coordinates (floor(voxel centre / cluster_size))
