@@ -21,12 +21,17 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 int32_t floor_div(int32_t v, int32_t s) { return v >= 0 ? v / s : -((-v + s - 1) / s); }
 
 // The 26 steps, each with its length in cells and the cells it cuts across (the steps along a
-// proper subset of its axes), so a diagonal step cannot slip between two blocked cells.
+// proper subset of its axes), so a diagonal step cannot slip between two blocked cells. Cells of
+// the 3x3x3 block around a cell are numbered (dx + 1) + 3 (dy + 1) + 9 (dz + 1); 13 is the cell.
 struct Step {
   VoxelKey d;
+  int k = 0;
   double length = 0.0;
-  std::vector<VoxelKey> across;
+  int across[6] = {0, 0, 0, 0, 0, 0};
+  int n_across = 0;
 };
+
+int block_index(const VoxelKey& d) { return (d.x + 1) + 3 * (d.y + 1) + 9 * (d.z + 1); }
 
 const std::vector<Step>& steps() {
   static const std::vector<Step> s = [] {
@@ -37,12 +42,13 @@ const std::vector<Step>& steps() {
           if (dx == 0 && dy == 0 && dz == 0) continue;
           Step st;
           st.d = {dx, dy, dz};
+          st.k = block_index(st.d);
           st.length = std::sqrt(static_cast<double>(dx * dx + dy * dy + dz * dz));
           for (int mask = 1; mask < 7; ++mask) {
             const VoxelKey sub{(mask & 1) ? dx : 0, (mask & 2) ? dy : 0, (mask & 4) ? dz : 0};
             if (sub == st.d || sub == VoxelKey{0, 0, 0}) continue;
-            if ((dx == 0 && sub.x) || (dy == 0 && sub.y) || (dz == 0 && sub.z)) continue;
-            if (std::find(st.across.begin(), st.across.end(), sub) == st.across.end()) st.across.push_back(sub);
+            const int k = block_index(sub);
+            if (std::find(st.across, st.across + st.n_across, k) == st.across + st.n_across) st.across[st.n_across++] = k;
           }
           out.push_back(st);
         }
@@ -160,6 +166,14 @@ void GridSearch::prepare(Lattice& l) {
     n.parent.assign(cells, -1);
     n.stamp.assign(cells, 0);
     n.closed.assign(cells, 0);
+    const size_t columns = static_cast<size_t>(n.nx) * static_cast<size_t>(n.ny);
+    n.col_set.assign(columns, 0);
+    n.col_pass.assign(columns, 0);
+    n.col_high.assign(columns, 0);
+    n.col_g.assign(columns, kInfF);
+    n.col_parent.assign(columns, -1);
+    n.col_stamp.assign(columns, 0);
+    n.col_closed.assign(columns, 0);
     l = std::move(n);
     if (&l == &coarse_) tree_valid_ = false;
   }
@@ -181,6 +195,8 @@ void GridSearch::invalidate(Lattice& l, const VoxelKey& block) {
             y1 = std::min(floor_div(v1.y, l.stride) - l.origin.y, l.ny - 1);
   const int z0 = std::max(floor_div(v0.z, l.stride) - l.origin.z, 0),
             z1 = std::min(floor_div(v1.z, l.stride) - l.origin.z, l.nz - 1);
+  for (int y = y0; y <= y1 && !l.col_set.empty(); ++y)
+    for (int x = x0; x <= x1; ++x) l.col_set[static_cast<size_t>(x) + static_cast<size_t>(l.nx) * y] = 0;
   for (int z = z0; z <= z1; ++z)
     for (int y = y0; y <= y1; ++y) {
       const size_t row = static_cast<size_t>(l.nx) * (static_cast<size_t>(y) + static_cast<size_t>(l.ny) * z);
@@ -235,6 +251,8 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
   escape_cache_.clear();
   const double cell = grid_->resolution() * l.stride;
   const bool astar = goal_index >= 0;
+  int64_t offset[27];
+  for (const Step& st : steps()) offset[st.k] = st.d.x + static_cast<int64_t>(l.nx) * (st.d.y + static_cast<int64_t>(l.ny) * st.d.z);
   using Item = std::pair<float, int64_t>;  // (g + h, index); ties go to the lower index
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
   auto h = [&](int64_t i) { return astar ? static_cast<float>((point(l, l.coords(i)) - goal).norm()) : 0.0f; };
@@ -257,20 +275,24 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
     if (settle(i)) break;
     const VoxelKey c = l.coords(i);
     const float gi = l.g[si];
+    // Each cell of the block around c is asked once (a step and the cells it cuts across share
+    // them); inside the box the neighbours' indices are fixed offsets.
+    const bool inside = c.x > l.origin.x && c.y > l.origin.y && c.z > l.origin.z && c.x < l.origin.x + l.nx - 1 &&
+                        c.y < l.origin.y + l.ny - 1 && c.z < l.origin.z + l.nz - 1;
+    int64_t nb_index[27];
+    uint8_t nb[27];
     for (const Step& st : steps()) {
-      const int64_t j = l.index(c + st.d);
-      if (j < 0 || l.closed[static_cast<size_t>(j)] == l.now || !allowed(j)) continue;
-      const bool is_goal = j == goal_index;
-      const uint8_t pj = is_goal ? static_cast<uint8_t>(kLow) : passable(l, j, source, escape);
-      if (pj == kBlocked) continue;
+      const int64_t j = inside ? i + offset[st.k] : l.index(c + st.d);
+      nb_index[st.k] = j;
+      nb[st.k] = j < 0 ? static_cast<uint8_t>(kBlocked)
+                       : (j == goal_index ? static_cast<uint8_t>(kLow) : passable(l, j, source, escape));
+    }
+    for (const Step& st : steps()) {
+      const int64_t j = nb_index[st.k];
+      const uint8_t pj = nb[st.k];
+      if (pj == kBlocked || l.closed[static_cast<size_t>(j)] == l.now || !allowed(j)) continue;
       bool cut = false;
-      for (const VoxelKey& a : st.across) {
-        const int64_t k = l.index(c + a);
-        if (k < 0 || passable(l, k, source, escape) == kBlocked) {
-          cut = true;
-          break;
-        }
-      }
+      for (int a = 0; a < st.n_across && !cut; ++a) cut = nb[st.across[a]] == kBlocked;
       if (cut) continue;
       const double w = pj == kHigh ? 1.0 : 1.0 + low_penalty_;
       const float g = gi + static_cast<float>(st.length * cell * w);
@@ -285,56 +307,170 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
   return settled;
 }
 
+void GridSearch::column(int64_t col, uint64_t& pass, uint64_t& high) {
+  Lattice& l = coarse_;
+  if (l.col_set[static_cast<size_t>(col)]) {
+    pass = l.col_pass[static_cast<size_t>(col)];
+    high = l.col_high[static_cast<size_t>(col)];
+    return;
+  }
+  pass = high = 0;
+  const int64_t plane = static_cast<int64_t>(l.nx) * l.ny;
+  for (int z = 0; z < std::min(l.nz, 64); ++z) {
+    const uint8_t c = cls(l, col + plane * z);
+    if (c != kBlocked) pass |= uint64_t{1} << z;
+    if (c == kHigh) high |= uint64_t{1} << z;
+  }
+  l.col_set[static_cast<size_t>(col)] = 1;
+  l.col_pass[static_cast<size_t>(col)] = pass;
+  l.col_high[static_cast<size_t>(col)] = high;
+}
+
 GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool escape,
                                          const std::vector<Eigen::Vector3d>& targets, int64_t max_settled,
                                          bool keep_tree) {
   Result r;
   r.distance.assign(targets.size(), kInf);
   if (keep_tree) tree_valid_ = false;
-  if (!grid_ || !source.allFinite()) return r;
+  if (!grid_ || !source.allFinite() || targets.empty()) return r;
   Lattice& l = coarse_;
   prepare(l);
-  const int64_t s = l.nx > 0 ? l.index(lattice_of(l, source)) : -1;
-  if (s < 0) return r;
+  if (l.nx <= 0) return r;
+  const VoxelKey sc = lattice_of(l, source);
+  const int64_t s3 = l.index(sc);
+  if (s3 < 0) return r;
+  const int64_t plane = static_cast<int64_t>(l.nx) * l.ny;
+  const int64_t s = s3 % plane;
   // The escape rule only where the vehicle needs it (the source's own cell is not passable).
-  escape = escape && cls(l, s) == kBlocked;
-  std::vector<std::pair<int64_t, double>> seeds;
-  if (escape || cls(l, s) != kBlocked) {
-    seeds.emplace_back(s, (point(l, l.coords(s)) - source).norm());
-  } else {
-    for (int64_t j : cells_near(l, source))
-      if (cls(l, j) != kBlocked) seeds.emplace_back(j, (point(l, l.coords(j)) - source).norm());
+  escape = escape && cls(l, s3) == kBlocked;
+  const double cell = grid_->resolution() * l.stride;
+  auto centre = [&](int64_t col) -> Eigen::Vector2d {
+    return Eigen::Vector2d((l.origin.x + col % l.nx) * l.stride + 0.5 * l.stride,
+                           (l.origin.y + col / l.nx) * l.stride + 0.5 * l.stride) *
+           grid_->resolution();
+  };
+  // A column's heights, with those of the escape zone around the source.
+  std::unordered_map<int64_t, std::pair<uint64_t, uint64_t>> escaped;
+  auto heights = [&](int64_t col, uint64_t& pass, uint64_t& high) {
+    column(col, pass, high);
+    if (!escape || (centre(col) - source.head<2>()).norm() > collision_.root_escape_radius + cell) return;
+    const auto it = escaped.find(col);
+    if (it != escaped.end()) {
+      pass = it->second.first;
+      high = it->second.second;
+      return;
+    }
+    for (int z = 0; z < std::min(l.nz, 64); ++z)
+      if (!(pass >> z & 1u) && passable(l, col + plane * z, source, true) != kBlocked) pass |= uint64_t{1} << z;
+    escaped.emplace(col, std::make_pair(pass, high));
+  };
+  escape_cache_.clear();
+  if (++l.now == 0) {
+    std::fill(l.col_stamp.begin(), l.col_stamp.end(), 0);
+    std::fill(l.col_closed.begin(), l.col_closed.end(), 0);
+    l.now = 1;
   }
-  // Each target is served by its cell and the cells around it.
+  using Item = std::pair<float, int64_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
+  auto seed = [&](int64_t col) {
+    const float g = static_cast<float>((centre(col) - source.head<2>()).norm());
+    const size_t i = static_cast<size_t>(col);
+    if (l.col_stamp[i] == l.now && l.col_g[i] <= g) return;
+    l.col_stamp[i] = l.now;
+    l.col_g[i] = g;
+    l.col_parent[i] = -1;
+    open.emplace(g, col);
+  };
+  uint64_t sp = 0, sh = 0;
+  heights(s, sp, sh);
+  const int sx = static_cast<int>(s % l.nx), sy = static_cast<int>(s / l.nx);
+  if (sp != 0) {
+    seed(s);
+  } else {
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (sx + dx < 0 || sy + dy < 0 || sx + dx >= l.nx || sy + dy >= l.ny) continue;
+        const int64_t c = s + dx + static_cast<int64_t>(l.nx) * dy;
+        uint64_t p = 0, h = 0;
+        heights(c, p, h);
+        if (p != 0) seed(c);
+      }
+  }
+  // Each target is served by its column and the eight around it.
   std::unordered_map<int64_t, std::vector<size_t>> serves;
   std::vector<std::vector<int64_t>> near(targets.size());
   for (size_t t = 0; t < targets.size(); ++t) {
     if (!targets[t].allFinite()) continue;
-    near[t] = cells_near(l, targets[t]);
-    for (int64_t j : near[t]) serves[j].push_back(t);
+    const int64_t c3 = l.index(lattice_of(l, targets[t]));
+    if (c3 < 0) continue;
+    const int64_t c = c3 % plane;
+    const int cx = static_cast<int>(c % l.nx), cy = static_cast<int>(c / l.nx);
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (cx + dx < 0 || cy + dy < 0 || cx + dx >= l.nx || cy + dy >= l.ny) continue;
+        const int64_t j = c + dx + static_cast<int64_t>(l.nx) * dy;
+        near[t].push_back(j);
+        serves[j].push_back(t);
+      }
   }
   std::vector<bool> touched(targets.size(), false);
   size_t left = 0;
   for (size_t t = 0; t < targets.size(); ++t) left += near[t].empty() ? 0 : 1;
-  r.settled = search(
-      l, seeds, source, escape, -1, source, max_settled, [](int64_t) { return true; },
-      [&](int64_t i) {
-        const auto it = serves.find(i);
-        if (it == serves.end()) return false;
-        for (size_t t : it->second) {
-          if (!touched[t]) {
-            touched[t] = true;
-            --left;
-          }
-        }
-        return left == 0 && !keep_tree;
-      });
-  for (size_t t = 0; t < targets.size(); ++t) {
-    for (int64_t j : near[t]) {
-      if (l.closed[static_cast<size_t>(j)] != l.now) continue;
-      r.distance[t] = std::min(r.distance[t], static_cast<double>(l.g[static_cast<size_t>(j)]) +
-                                                  (targets[t] - point(l, l.coords(j))).norm());
+  static const int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1}, kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  while (!open.empty() && r.settled < max_settled && left > 0) {
+    const auto [f, c] = open.top();
+    open.pop();
+    const size_t ci = static_cast<size_t>(c);
+    if (l.col_closed[ci] == l.now) continue;
+    l.col_closed[ci] = l.now;
+    ++r.settled;
+    const auto it = serves.find(c);
+    if (it != serves.end()) {
+      for (size_t t : it->second) {
+        if (!touched[t]) touched[t] = true, --left;
+      }
     }
+    uint64_t pc = 0, hc = 0;
+    heights(c, pc, hc);
+    const int cx = static_cast<int>(c % l.nx), cy = static_cast<int>(c / l.nx);
+    for (int k = 0; k < 8; ++k) {
+      const int nx = cx + kDx[k], ny = cy + kDy[k];
+      if (nx < 0 || ny < 0 || nx >= l.nx || ny >= l.ny) continue;
+      const int64_t n = nx + static_cast<int64_t>(l.nx) * ny;
+      if (l.col_closed[static_cast<size_t>(n)] == l.now) continue;
+      uint64_t pn = 0, hn = 0;
+      heights(n, pn, hn);
+      // A step needs a height both columns are passable at (and, diagonally, the two columns it
+      // cuts between too).
+      uint64_t common = pc & pn, open_high = hc & hn;
+      if (k >= 4) {
+        uint64_t pa = 0, ha = 0, pb = 0, hb = 0;
+        heights(cx + kDx[k] + static_cast<int64_t>(l.nx) * cy, pa, ha);
+        heights(cx + static_cast<int64_t>(l.nx) * (cy + kDy[k]), pb, hb);
+        common &= pa & pb;
+        open_high &= ha & hb;
+      }
+      if (common == 0) continue;
+      const double w = open_high != 0 ? 1.0 : 1.0 + low_penalty_;
+      const float g = l.col_g[ci] + static_cast<float>((k >= 4 ? std::sqrt(2.0) : 1.0) * cell * w);
+      const size_t ni = static_cast<size_t>(n);
+      if (l.col_stamp[ni] == l.now && l.col_g[ni] <= g) continue;
+      l.col_stamp[ni] = l.now;
+      l.col_g[ni] = g;
+      l.col_parent[ni] = static_cast<int32_t>(c);
+      open.emplace(g, n);
+    }
+  }
+  // The columns ignore height: the climb between source and target is added to the horizontal
+  // path (in quadrature, as if spread along it).
+  for (size_t t = 0; t < targets.size(); ++t) {
+    double best = kInf;
+    for (int64_t j : near[t]) {
+      if (l.col_closed[static_cast<size_t>(j)] != l.now) continue;
+      best = std::min(best, static_cast<double>(l.col_g[static_cast<size_t>(j)]) +
+                                (targets[t].head<2>() - centre(j)).norm());
+    }
+    if (best < kInf) r.distance[t] = std::hypot(best, targets[t].z() - source.z());
   }
   if (keep_tree) {
     tree_valid_ = true;
@@ -342,11 +478,10 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
     tree_origin_ = l.origin;
     tree_nx_ = l.nx;
     tree_ny_ = l.ny;
-    tree_nz_ = l.nz;
-    tree_g_.assign(l.g.size(), kInfF);
-    tree_parent_ = l.parent;
-    for (size_t i = 0; i < l.g.size(); ++i)
-      if (l.closed[i] == l.now) tree_g_[i] = l.g[i];
+    tree_g_.assign(l.col_g.size(), kInfF);
+    tree_parent_ = l.col_parent;
+    for (size_t i = 0; i < l.col_g.size(); ++i)
+      if (l.col_closed[i] == l.now) tree_g_[i] = l.col_g[i];
   }
   return r;
 }
@@ -354,25 +489,38 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
 std::vector<Eigen::Vector3d> GridSearch::tree_path(const Eigen::Vector3d& target) const {
   std::vector<Eigen::Vector3d> out;
   if (!tree_valid_ || !grid_ || !target.allFinite()) return out;
-  Lattice t;  // the tree's geometry
-  t.stride = coarse_.stride;
-  t.origin = tree_origin_;
-  t.nx = tree_nx_;
-  t.ny = tree_ny_;
-  t.nz = tree_nz_;
+  const double res = grid_->resolution();
+  const int st = coarse_.stride;
+  const VoxelKey v = grid_->keys().key(target);
+  const int cx = floor_div(v.x, st) - tree_origin_.x, cy = floor_div(v.y, st) - tree_origin_.y;
+  auto centre = [&](int64_t col) -> Eigen::Vector2d {
+    return Eigen::Vector2d((tree_origin_.x + col % tree_nx_) * st + 0.5 * st,
+                           (tree_origin_.y + col / tree_nx_) * st + 0.5 * st) *
+           res;
+  };
   int64_t best = -1;
   double best_d = kInf;
-  for (int64_t j : cells_near(t, target)) {
-    const double g = tree_g_[static_cast<size_t>(j)];
-    if (!(g < kInf)) continue;
-    const double d = g + (target - point(t, t.coords(j))).norm();
-    if (d < best_d) best_d = d, best = j;
-  }
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      if (cx + dx < 0 || cy + dy < 0 || cx + dx >= tree_nx_ || cy + dy >= tree_ny_) continue;
+      const int64_t j = cx + dx + static_cast<int64_t>(tree_nx_) * (cy + dy);
+      const double g = tree_g_[static_cast<size_t>(j)];
+      if (!(g < kInf)) continue;
+      const double d = g + (target.head<2>() - centre(j)).norm();
+      if (d < best_d) best_d = d, best = j;
+    }
   if (best < 0) return out;
-  std::vector<Eigen::Vector3d> rev{target};
-  for (int64_t i = best; i >= 0; i = tree_parent_[static_cast<size_t>(i)]) rev.push_back(point(t, t.coords(i)));
-  rev.push_back(tree_source_);
-  out.assign(rev.rbegin(), rev.rend());
+  std::vector<Eigen::Vector2d> rev;
+  for (int64_t i = best; i >= 0; i = tree_parent_[static_cast<size_t>(i)]) rev.push_back(centre(i));
+  // Heights from the source's to the target's along the way (the corridor only uses x and y).
+  out.push_back(tree_source_);
+  const double n = static_cast<double>(rev.size() + 1);
+  for (size_t k = 0; k < rev.size(); ++k) {
+    const double t = static_cast<double>(k + 1) / n;
+    const Eigen::Vector2d& c = rev[rev.size() - 1 - k];
+    out.emplace_back(c.x(), c.y(), tree_source_.z() + t * (target.z() - tree_source_.z()));
+  }
+  out.push_back(target);
   return out;
 }
 
@@ -392,19 +540,18 @@ bool GridSearch::find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, c
   const int64_t goal = l.nx > 0 ? l.index(lattice_of(l, b)) : -1;
   if (s < 0 || goal < 0) return false;
   const bool escape = cls(l, s) == kBlocked;
-  // The corridor: coarse cells within two of the guide's.
+  // The corridor: coarse columns within two of the guide's, at any height.
   std::unordered_set<uint64_t> corridor;
   const int cs = coarse_.stride;
   for (const Eigen::Vector3d& g : guide) {
     const VoxelKey c = lattice_of(coarse_, g);
-    for (int dz = -2; dz <= 2; ++dz)
-      for (int dy = -2; dy <= 2; ++dy)
-        for (int dx = -2; dx <= 2; ++dx) corridor.insert(pack(VoxelKey{c.x + dx, c.y + dy, c.z + dz}));
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx) corridor.insert(pack(VoxelKey{c.x + dx, c.y + dy, 0}));
   }
   auto allowed = [&](int64_t j) {
     if (corridor.empty()) return true;
     const VoxelKey v = l.coords(j);
-    return corridor.count(pack(VoxelKey{floor_div(v.x, cs), floor_div(v.y, cs), floor_div(v.z, cs)})) != 0;
+    return corridor.count(pack(VoxelKey{floor_div(v.x, cs), floor_div(v.y, cs), 0})) != 0;
   };
   bool reached = false;
   const int64_t n = search(l, {{s, 0.0}}, a, escape, goal, b, max_expansions, allowed, [&](int64_t i) {

@@ -224,10 +224,11 @@ int main(int argc, char** argv) {
           const StatusReport& s = *out.status;
           std::printf(
               "t=%7.2f it=%4lld %-10s nodes=%4d ms=%6.2f (s %.2f c %.2f g %.2f q %.2f) evals=%lld "
-              "charged=%.1fms %s\n",
+              "settled=%lld charged=%.1fms %s\n",
               t, static_cast<long long>(s.iteration), to_string(s.state), s.num_nodes, s.counters.total_ms,
               s.counters.sample_ms, s.counters.connect_ms, s.counters.gain_ms, s.counters.search_ms,
-              static_cast<long long>(s.counters.gain_evaluations), 1e3 * s.charged_s, s.reason.c_str());
+              static_cast<long long>(s.counters.gain_evaluations), static_cast<long long>(s.counters.search_settled),
+              1e3 * s.charged_s, s.reason.c_str());
         }
       });
       if (kernels && run == 0) time_kernels(sim.known(), c);
@@ -267,6 +268,9 @@ int main(int argc, char** argv) {
       collisions += r.collisions;
       paths += r.paths;
       done += r.done ? 1 : 0;
+      if (verbose) {
+        for (const auto& [t, c] : r.coverage_curve) std::printf("coverage_at %.1f s: %.2f %%\n", t, 100.0 * c);
+      }
       if (verbose)
         std::printf("run %lld: %s after %.1f s: %s\n", static_cast<long long>(run),
                     r.done ? "DONE" : "stopped", r.time_s, r.reason.c_str());

@@ -84,6 +84,13 @@ class GridSearch {
     std::vector<uint32_t> stamp;   // g and parent hold for this search when == now
     std::vector<uint32_t> closed;  // settled in this search when == now
     uint32_t now = 0;
+    // Per column (x, y) of the coarse lattice: the heights (bit z) it is passable at, and at which
+    // of them the clearance is passage_clearance; and the column search's scratch.
+    std::vector<uint8_t> col_set;
+    std::vector<uint64_t> col_pass, col_high;
+    std::vector<float> col_g;
+    std::vector<int32_t> col_parent;
+    std::vector<uint32_t> col_stamp, col_closed;
     int64_t index(const map::VoxelKey& l) const;
     map::VoxelKey coords(int64_t i) const;
   };
@@ -101,6 +108,8 @@ class GridSearch {
   int64_t search(Lattice& l, const std::vector<std::pair<int64_t, double>>& seeds, const Eigen::Vector3d& source,
                  bool escape, int64_t goal_index, const Eigen::Vector3d& goal, int64_t max_settled,
                  Allowed&& allowed, Settle&& settle);
+  // A coarse column's passable heights and those with passage clearance (cached).
+  void column(int64_t col, uint64_t& pass, uint64_t& high);
   // The cells that stand for p: its own and its 26 neighbours.
   std::vector<int64_t> cells_near(const Lattice& l, const Eigen::Vector3d& p) const;
 
@@ -117,7 +126,7 @@ class GridSearch {
   std::vector<float> tree_g_;
   std::vector<int32_t> tree_parent_;
   map::VoxelKey tree_origin_;
-  int tree_nx_ = 0, tree_ny_ = 0, tree_nz_ = 0;
+  int tree_nx_ = 0, tree_ny_ = 0;
 };
 
 }  // namespace semx::planner
