@@ -90,7 +90,8 @@ const std::vector<Viewpoint>& FuelStrategy::viewpoints(int64_t cluster) const {
 
 bool FuelStrategy::eligible(const PlanContext& ctx, const VoxelKey& k) const {
   // Voxels found unobservable (seen from a reached goal and still unknown) are nothing to visit.
-  return ctx.frontiers->contains(k) && !(ctx.unobservable && ctx.unobservable->contains(k));
+  return (k.z + 0.5) * clusters_.resolution() >= config_.fuel.min_frontier_z && ctx.frontiers->contains(k) &&
+         !(ctx.unobservable && ctx.unobservable->contains(k));
 }
 
 void FuelStrategy::update_clusters(PlanContext& ctx) {

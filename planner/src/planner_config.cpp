@@ -156,6 +156,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   auto f = m.child("fuel");
   FuelConfig& fu = c.fuel;
   f.get("min_cluster_voxels", fu.min_cluster_voxels, 1, 1000000);
+  f.get("min_frontier_z", fu.min_frontier_z, -1000.0, 1000.0);
   f.get("split_radius", fu.split_radius, 0.1, 100.0);
   f.get("view_radius_min", fu.view_radius_min, 0.0, 100.0);
   f.get("view_radius_max", fu.view_radius_max, 0.0, 100.0);

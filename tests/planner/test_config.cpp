@@ -86,6 +86,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(aep.cache_radius);
   SAME(aep.g_zero);
   SAME(fuel.min_cluster_voxels);
+  SAME(fuel.min_frontier_z);
   SAME(fuel.split_radius);
   SAME(fuel.view_radius_min);
   SAME(fuel.view_radius_max);

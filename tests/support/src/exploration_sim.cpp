@@ -1,5 +1,8 @@
 #include "semx/fixtures/exploration_sim.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
 #include <cmath>
 
 #include "semx/core/angles.hpp"
@@ -111,7 +114,14 @@ ExplorationSimResult ExplorationSim::run(
   for (int64_t i = 1; i <= steps; ++i) {
     const double t = i * options_.dt;
     move(options_.dt);
-    if (world_.collides(pose_.position, body)) ++r.collisions;
+    if (world_.collides(pose_.position, body)) {
+      ++r.collisions;
+      if (std::getenv("SEMX_SIM_DEBUG"))
+        std::fprintf(stderr, "collision t=%.2f at (%.3f %.3f %.3f) yaw %.2f path %zu/%zu\n", t, pose_.position.x(),
+                     pose_.position.y(), pose_.position.z(), pose_.yaw, next_waypoint_, path_.waypoints.size());
+      if (std::getenv("SEMX_SIM_DEBUG"))
+        for (const auto& w : path_.waypoints) std::fprintf(stderr, "   wp (%.3f %.3f %.3f)\n", w.x(), w.y(), w.z());
+    }
     if (t + 1e-9 >= next_observe) {
       observe();
       update_regions(t, r);

@@ -64,14 +64,18 @@ class GridSearch {
   bool find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const std::vector<Eigen::Vector3d>& guide,
                  int64_t max_expansions, std::vector<Eigen::Vector3d>& out, int64_t* expanded = nullptr);
   // Drops every point of `path` that its neighbours can be joined around with a segment that
-  // passes the check (root_edge_free from path[0], edge_free after), greedily from the start.
-  // False when some consecutive pair does not pass.
-  bool shorten(const std::vector<Eigen::Vector3d>& path, std::vector<Eigen::Vector3d>& out) const;
+  // passes edge_free, greedily from the start; with first > 0 (a start without the clearance) the
+  // first segment goes to path[first] under root_edge_free's escape rule (checked to each point
+  // up to it). False when some consecutive pair does not pass.
+  bool shorten(const std::vector<Eigen::Vector3d>& path, std::vector<Eigen::Vector3d>& out, size_t first = 0) const;
 
   int step() const { return coarse_.stride; }
+  // The body box with a small margin overlaps no occupied or unknown voxel anywhere on a-b.
+  bool body_clear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
  private:
-  enum : uint8_t { kUnset = 0, kBlocked = 1, kLow = 2, kHigh = 3 };
+  // kEscape: passable only by the escape rule near the search's source (never cached).
+  enum : uint8_t { kUnset = 0, kBlocked = 1, kLow = 2, kHigh = 3, kEscape = 4 };
   // A dense box of cells of `stride` voxels, with passability and the search's scratch.
   struct Lattice {
     int stride = 1;

@@ -215,6 +215,9 @@ struct FuelConfig {
   // 100 free-side voxels; here the frontier is the unknown side (FrontierTracker), and 100 left
   // corners of env3 unvisited (docs/planner.md, "FUEL").
   int min_cluster_voxels = 30;
+  // m: frontier voxels with a centre below this height are not clustered (FUEL's expandFrontier
+  // drops cells below 0.4 m as noise close to the ground).
+  double min_frontier_z = 0.4;
   // m: a cluster with a voxel farther than this horizontally from its mean is split in two along
   // its principal axis (FUEL's cluster_size_xy), so one viewpoint can see most of it.
   double split_radius = 2.0;
