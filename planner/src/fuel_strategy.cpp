@@ -1,6 +1,8 @@
 #include "semx/planner/fuel_strategy.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -22,6 +24,9 @@ constexpr int64_t kMaxFieldCells = 4000000;
 constexpr int64_t kMaxPathVoxels = 600000;
 // Goals tried per plan when the chosen one has no path.
 constexpr int kAttempts = 3;
+// A cluster without viewpoints is sampled again after this many cycles, this many per cycle.
+constexpr int64_t kResampleCycles = 8;
+constexpr int kResampleClusters = 3;
 
 const std::vector<Viewpoint> kNoViews;
 
@@ -59,6 +64,8 @@ void FuelStrategy::reset() {
   target_ = Target();
   switch_ = false;
   replan_reason_.clear();
+  velocity_.setZero();
+  last_utime_ = -1;
   sites_.clear();
   tour_.clear();
   search_.reset();
@@ -81,6 +88,16 @@ void FuelStrategy::on_map_reset() {
 
 void FuelStrategy::on_gain_invalidated(const std::vector<map::VoxelKey>& keys) {
   dirty_.insert(dirty_.end(), keys.begin(), keys.end());
+}
+
+double FuelStrategy::first_leg(double distance, const Eigen::Vector3d& p, double yaw) const {
+  double t = travel_time(distance, vehicle_yaw_, yaw, config_.cost);
+  // FUEL's ViewNode::computeCost: w_dir times the angle between the velocity and the straight
+  // direction to the viewpoint, added to the flight's part (here the whole lower bound).
+  const Eigen::Vector3d d = p - vehicle_;
+  if (velocity_.norm() > 0.1 && d.norm() > 1e-6)
+    t += config_.fuel.direction_weight * std::acos(std::clamp(velocity_.normalized().dot(d.normalized()), -1.0, 1.0));
+  return t;
 }
 
 const std::vector<Viewpoint>& FuelStrategy::viewpoints(int64_t cluster) const {
@@ -116,11 +133,28 @@ void FuelStrategy::update_clusters(PlanContext& ctx) {
   dirty_.clear();
   for (int64_t id : changes.removed) state_.erase(id);
   core::Stopwatch w;
-  for (int64_t id : changes.added) {
+  auto sample = [&](int64_t id) {
     ClusterState& s = state_[id];
-    s.views = sampler_.sample(grid, *clusters_.find(id), ctx.counters);
+    // The rings' phase is the seed's (FUEL's rings start at -pi; LKH, its tour solver, draws
+    // from a seed too): a run is a function of the seed, and seeds show how much one run's
+    // figures owe to where the candidates happened to fall.
+    const double phase = ctx.rng ? ctx.rng->uniform() : 0.0;
+    s.views = sampler_.sample(grid, *clusters_.find(id), ctx.counters, phase);
+    s.sampled_cycle = ctx.cycle;
     ctx.counters->samples_drawn += static_cast<int64_t>(config_.fuel.view_radius_steps) * config_.fuel.view_angles;
     ctx.counters->nodes_added += static_cast<int64_t>(s.views.size());
+  };
+  for (int64_t id : changes.added) sample(id);
+  // A cluster without a viewpoint is sampled again now and then: the space around it fills in
+  // (candidates that were unknown become free) while its own voxels, which alone would make it
+  // new, may not change.
+  int again = 0;
+  for (auto& [id, s] : state_) {
+    if (again >= kResampleClusters) break;
+    if (s.views.empty() && ctx.cycle - s.sampled_cycle >= kResampleCycles) {
+      sample(id);
+      ++again;
+    }
   }
   ctx.counters->gain_ms += w.ms();
 }
@@ -275,6 +309,25 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         }
       }
     }
+    // FUEL-size clusters first: the smaller ones only once none of those is left.
+    auto major = [&](const Site& s) {
+      const FrontierClusters::Cluster* c = clusters_.find(s.cluster);
+      return c && static_cast<int64_t>(c->voxels.size()) >= f.major_cluster_voxels &&
+             state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage;
+    };
+    if (std::any_of(sites_.begin(), sites_.end(), major))
+      sites_.erase(std::remove_if(sites_.begin(), sites_.end(), [&](const Site& s) { return !major(s); }),
+                   sites_.end());
+    if (std::getenv("SEMX_FUEL_DEBUG")) {
+      std::fprintf(stderr, "plan t=%.2f clusters=%zu sites:", 1e-6 * ctx.pose.utime, clusters_.clusters().size());
+      for (const auto& [id, cs] : state_) {
+        const FrontierClusters::Cluster* c = clusters_.find(id);
+        std::fprintf(stderr, " [%lld n=%zu m=(%.1f,%.1f,%.1f) v=%zu best=%.0f]", static_cast<long long>(id),
+                     c->voxels.size(), c->mean.x(), c->mean.y(), c->mean.z(), cs.views.size(),
+                     cs.views.empty() ? 0.0 : cs.views[0].coverage);
+      }
+      std::fprintf(stderr, "\n");
+    }
     if (waiting) *waiting = banned_only;
     if (sites_.empty()) {
       std::ostringstream r;
@@ -299,7 +352,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     for (int i = 0; i < n - 1; ++i) {
       const Site& s = sites_[static_cast<size_t>(i)];
       problem.cost[static_cast<size_t>(i + 1)] =
-          travel_time(s.vehicle_distance[static_cast<size_t>(s.rep)], vehicle_yaw_, rep_view(i).yaw, cost);
+          first_leg(s.vehicle_distance[static_cast<size_t>(s.rep)], rep_view(i).position, rep_view(i).yaw);
       for (int j = 0; j < n - 1; ++j) {
         if (i == j) continue;
         problem.cost[static_cast<size_t>(i + 1) * static_cast<size_t>(n) + static_cast<size_t>(j + 1)] =
@@ -357,7 +410,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       for (size_t c = 0; c < choices[l].size(); ++c) {
         const Viewpoint& vp = views[static_cast<size_t>(s.views[static_cast<size_t>(choices[l][c])])];
         if (l == 0) {
-          best[0][c] = travel_time(s.vehicle_distance[static_cast<size_t>(choices[0][c])], vehicle_yaw_, vp.yaw, cost);
+          best[0][c] = first_leg(s.vehicle_distance[static_cast<size_t>(choices[0][c])], vp.position, vp.yaw);
           continue;
         }
         const Site& ps = sites_[static_cast<size_t>(layer_site[l - 1])];
@@ -424,6 +477,10 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   checker_.reset_counters();
   vehicle_ = ctx.pose.position;
   vehicle_yaw_ = ctx.pose.yaw;
+  if (last_utime_ >= 0 && ctx.pose.utime > last_utime_)
+    velocity_ = (vehicle_ - last_position_) / (1e-6 * static_cast<double>(ctx.pose.utime - last_utime_));
+  last_position_ = vehicle_;
+  last_utime_ = ctx.pose.utime;
   {
     core::Stopwatch w;
     update_clusters(ctx);

@@ -156,6 +156,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   auto f = m.child("fuel");
   FuelConfig& fu = c.fuel;
   f.get("min_cluster_voxels", fu.min_cluster_voxels, 1, 1000000);
+  f.get("major_cluster_voxels", fu.major_cluster_voxels, 1, 1000000000);
+  f.get("major_coverage", fu.major_coverage, 0.0, 1e9);
   f.get("min_frontier_z", fu.min_frontier_z, -1000.0, 1000.0);
   f.get("split_radius", fu.split_radius, 0.1, 100.0);
   f.get("view_radius_min", fu.view_radius_min, 0.0, 100.0);
@@ -167,6 +169,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("coverage_cells", fu.coverage_cells, 1, 100000);
   f.get("min_coverage", fu.min_coverage, 0.0, 1e9);
   f.get("min_view_distance", fu.min_view_distance, 0.0, 100.0);
+  f.get("direction_weight", fu.direction_weight, 0.0, 100.0);
   f.get("refine_clusters", fu.refine_clusters, 1, 100);
   f.get("refine_radius", fu.refine_radius, 0.0, 1000.0);
   f.get("top_views", fu.top_views, 1, 10000);

@@ -86,6 +86,8 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(aep.cache_radius);
   SAME(aep.g_zero);
   SAME(fuel.min_cluster_voxels);
+  SAME(fuel.major_cluster_voxels);
+  SAME(fuel.major_coverage);
   SAME(fuel.min_frontier_z);
   SAME(fuel.split_radius);
   SAME(fuel.view_radius_min);
@@ -96,6 +98,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.coverage_cells);
   SAME(fuel.min_coverage);
   SAME(fuel.min_view_distance);
+  SAME(fuel.direction_weight);
   SAME(fuel.refine_clusters);
   SAME(fuel.refine_radius);
   SAME(fuel.top_views);

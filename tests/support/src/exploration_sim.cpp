@@ -127,6 +127,9 @@ ExplorationSimResult ExplorationSim::run(
       update_regions(t, r);
       next_observe += options_.observe_period;
     }
+    if (std::getenv("SEMX_SIM_TRACE") && i % 5 == 0)
+      std::fprintf(stderr, "pose t=%.2f %.2f %.2f %.2f yaw %.2f\n", t, pose_.position.x(), pose_.position.y(),
+                   pose_.position.z(), pose_.yaw);
     pose_.utime = static_cast<int64_t>(std::llround(t * 1e6));
     planner_.set_pose(pose_);
     if (holding_ && planner_.plan_id() > 0)

@@ -5,8 +5,9 @@
 //
 // A candidate sees a cluster voxel when the voxel is in the sensor model's range and vertical
 // field of view (GainEvaluator::in_sector, the camera every planner here uses) and the segment to
-// it crosses only known free voxels (FUEL: neither occupied nor unknown ones; the gain's
-// optimistic rule would count voxels behind unknown space that the camera does not see). The
+// it crosses only known free voxels up to the voxel's own surroundings (FUEL: neither occupied nor
+// unknown ones; the gain's optimistic rule would count voxels behind unknown space that the
+// camera does not see). The
 // seen voxels go to the gain's azimuth bins; the viewpoint's yaw is the centre of the window of
 // bins that holds the most (GainEvaluator::finish: among ties the middle of the first run), and
 // its coverage is that count, scaled from the tested voxels (at most fuel.coverage_cells, spread
@@ -36,9 +37,10 @@ class ViewpointSampler {
   ViewpointSampler(const PlannerConfig& config, const CollisionChecker& checker, const GainEvaluator& gains);
 
   // The cluster's viewpoints, best coverage first (ties: candidate order); empty when none sees
-  // min_coverage voxels. Counts its ray steps into `counters`.
+  // min_coverage voxels. The rings' directions start `phase` (0..1) of their spacing past -pi.
+  // Counts its ray steps into `counters`.
   std::vector<Viewpoint> sample(const map::StateGrid& grid, const FrontierClusters::Cluster& cluster,
-                                CycleCounters* counters) const;
+                                CycleCounters* counters, double phase = 0.0) const;
   // The coverage and yaw from one position (tests; sample() uses it for every candidate).
   Viewpoint view_from(const map::StateGrid& grid, const std::vector<map::VoxelKey>& cells, double scale,
                       const Eigen::Vector3d& p, int64_t* ray_steps) const;

@@ -69,6 +69,7 @@ class FuelStrategy : public Strategy {
  private:
   struct ClusterState {
     std::vector<Viewpoint> views;
+    int64_t sampled_cycle = 0;
     // Travel distances (m) from a representative to other clusters' representatives, each kept
     // with both positions so a changed representative is noticed.
     Eigen::Vector3d row_from = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -130,6 +131,12 @@ class FuelStrategy : public Strategy {
   std::vector<int64_t> tour_;
   Eigen::Vector3d vehicle_ = Eigen::Vector3d::Zero();
   double vehicle_yaw_ = 0.0;
+  // The vehicle's velocity, from its poses at the last two plans (FUEL reads it from odometry).
+  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_position_ = Eigen::Vector3d::Zero();
+  int64_t last_utime_ = -1;
+  // The first leg's cost from the vehicle to p: travel time plus the turn of the velocity.
+  double first_leg(double distance, const Eigen::Vector3d& p, double yaw) const;
 };
 
 // Yaws for a path flown by FUEL: from `start_yaw` toward `goal_yaw` (the shorter way) as fast as

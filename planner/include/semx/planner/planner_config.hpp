@@ -211,10 +211,15 @@ struct AepConfig {
 // (exploration_manager/launch/algorithm.xml) where this map allows them; docs/planner.md, "FUEL",
 // says where and why they differ.
 struct FuelConfig {
-  // Frontier voxels a connected group needs to be a cluster worth visiting. FUEL's cluster_min is
-  // 100 free-side voxels; here the frontier is the unknown side (FrontierTracker), and 100 left
-  // corners of env3 unvisited (docs/planner.md, "FUEL").
+  // Frontier voxels a connected group needs to be a cluster (and to be visited at all).
   int min_cluster_voxels = 30;
+  // While any cluster has major_cluster_voxels voxels and a viewpoint that sees major_coverage of
+  // them, the tour visits only such clusters: FUEL's own thresholds (cluster_min 100 cells,
+  // min_visib_num 15 cells of 0.3 m), below which FUEL drops a cluster for good. Smaller ones are
+  // visited after them, so the end of the exploration covers what the other planners cover
+  // (docs/planner.md, "FUEL").
+  int major_cluster_voxels = 100;
+  double major_coverage = 100.0;
   // m: frontier voxels with a centre below this height are not clustered (FUEL's expandFrontier
   // drops cells below 0.4 m as noise close to the ground).
   double min_frontier_z = 0.4;
@@ -241,6 +246,10 @@ struct FuelConfig {
   // A viewpoint nearer than this to the vehicle is not a cluster's tour representative while
   // another is (FUEL's min_candidate_dist).
   double min_view_distance = 0.75;  // m
+  // s per rad: the first leg of a tour costs this much more per radian between the vehicle's
+  // velocity and the direction to its viewpoint (FUEL's w_dir, motion consistency), so a replan
+  // does not turn the vehicle back for a target about as cheap as the one ahead.
+  double direction_weight = 1.5;
   // Local refinement (FUEL's refined_num, refined_radius, top_view_num, max_decay): the first
   // refine_clusters clusters of the tour, up to the first beyond refine_radius (at least two),
   // each choosing among its top_views viewpoints with coverage above max_decay x its best.
