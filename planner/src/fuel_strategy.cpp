@@ -65,6 +65,7 @@ void FuelStrategy::reset() {
   switch_ = false;
   replan_reason_.clear();
   velocity_.setZero();
+  yaw_speed_ = 0.0;
   last_utime_ = -1;
   sites_.clear();
   tour_.clear();
@@ -475,12 +476,32 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   search_.set_grid(ctx.grid);
   gains_.set_ignored(ctx.unobservable);
   checker_.reset_counters();
+  if (last_utime_ >= 0 && ctx.pose.utime > last_utime_) {
+    const double dt = 1e-6 * static_cast<double>(ctx.pose.utime - last_utime_);
+    velocity_ = (ctx.pose.position - last_position_) / dt;
+    yaw_speed_ = core::wrap_angle(ctx.pose.yaw - last_yaw_) / dt;
+  }
+  last_position_ = ctx.pose.position;
+  last_yaw_ = ctx.pose.yaw;
+  last_utime_ = ctx.pose.utime;
+  // FUEL replans from where the vehicle will be on its trajectory when the new one starts
+  // (FastExplorationFSM: replan_time ahead), not from where it is: a path from the pose of the
+  // cycle sends the vehicle back to it once released (the least charge later), and the closed
+  // loop turned back to the old heading at every replan (env1: 0.4 rad/s of the 1 rad/s turn).
   vehicle_ = ctx.pose.position;
   vehicle_yaw_ = ctx.pose.yaw;
-  if (last_utime_ >= 0 && ctx.pose.utime > last_utime_)
-    velocity_ = (vehicle_ - last_position_) / (1e-6 * static_cast<double>(ctx.pose.utime - last_utime_));
-  last_position_ = vehicle_;
-  last_utime_ = ctx.pose.utime;
+  const double lead = config_.charge.scale * config_.charge.min_s;
+  if (lead > 0 && velocity_.norm() > 1e-3) {
+    const Eigen::Vector3d v = velocity_.norm() > config_.cost.velocity
+                                  ? Eigen::Vector3d(velocity_.normalized() * config_.cost.velocity)
+                                  : velocity_;
+    const Eigen::Vector3d ahead = ctx.pose.position + lead * v;
+    checker_.set_grid(ctx.grid);
+    if (ctx.grid->state(ahead) == map::VoxelState::kFree && checker_.edge_free(ctx.pose.position, ahead))
+      vehicle_ = ahead;
+  }
+  vehicle_yaw_ = core::wrap_angle(
+      ctx.pose.yaw + lead * std::clamp(yaw_speed_, -config_.cost.yaw_rate, config_.cost.yaw_rate));
   {
     core::Stopwatch w;
     update_clusters(ctx);

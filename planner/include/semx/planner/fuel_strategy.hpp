@@ -131,9 +131,13 @@ class FuelStrategy : public Strategy {
   std::vector<int64_t> tour_;
   Eigen::Vector3d vehicle_ = Eigen::Vector3d::Zero();
   double vehicle_yaw_ = 0.0;
-  // The vehicle's velocity, from its poses at the last two plans (FUEL reads it from odometry).
+  // The vehicle's velocity and turn rate, from its poses at the last two plans (FUEL reads them
+  // from its trajectory); vehicle_ and vehicle_yaw_ are where they take it by the time a plan is
+  // released.
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  double yaw_speed_ = 0.0;
   Eigen::Vector3d last_position_ = Eigen::Vector3d::Zero();
+  double last_yaw_ = 0.0;
   int64_t last_utime_ = -1;
   // The first leg's cost from the vehicle to p: travel time plus the turn of the velocity.
   double first_leg(double distance, const Eigen::Vector3d& p, double yaw) const;
