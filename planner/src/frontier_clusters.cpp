@@ -2,7 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <unordered_set>
+
+#include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
 
@@ -69,10 +70,10 @@ FrontierClusters::Changes FrontierClusters::rebuild(std::vector<VoxelKey> voxels
 void FrontierClusters::grow(std::vector<VoxelKey> seeds, const Eligible& eligible, Changes& out) {
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
-  std::unordered_set<VoxelKey> visited;
+  VoxelSet visited;
   std::vector<VoxelKey> queue;
   for (const VoxelKey& s : seeds) {
-    if (visited.count(s) || owner(s) >= 0 || !eligible(s)) continue;
+    if (!eligible(s) || visited.contains(s) || owner(s) >= 0) continue;
     // Region growing over the 26 neighbours (FUEL's expandFrontier), stopping at voxels that a
     // cluster which did not change still holds.
     queue.assign(1, s);
@@ -84,7 +85,8 @@ void FrontierClusters::grow(std::vector<VoxelKey> seeds, const Eligible& eligibl
           for (int dx = -1; dx <= 1; ++dx) {
             if (dx == 0 && dy == 0 && dz == 0) continue;
             const VoxelKey n{c.x + dx, c.y + dy, c.z + dz};
-            if (visited.count(n) || owner(n) >= 0 || !eligible(n)) continue;
+            // Most neighbours are not frontier voxels: the (block-cached) eligibility first.
+            if (!eligible(n) || visited.contains(n) || owner(n) >= 0) continue;
             visited.insert(n);
             queue.push_back(n);
           }

@@ -120,7 +120,14 @@ void FuelStrategy::update_clusters(PlanContext& ctx) {
     rebuild_ = true;
   }
   if (!ctx.frontiers) return;
-  const FrontierClusters::Eligible ok = [&](const VoxelKey& k) { return eligible(ctx, k); };
+  // eligible() with cursors: the region growing asks about every neighbour of every voxel.
+  VoxelSet::Cursor frontier(ctx.frontiers->bits());
+  std::optional<VoxelSet::Cursor> ignored;
+  if (ctx.unobservable) ignored.emplace(*ctx.unobservable);
+  const double res = grid.resolution(), z_min = config_.fuel.min_frontier_z;
+  const FrontierClusters::Eligible ok = [&](const VoxelKey& k) {
+    return (k.z + 0.5) * res >= z_min && frontier.contains(k) && !(ignored && ignored->contains(k));
+  };
   FrontierClusters::Changes changes;
   if (rebuild_) {
     const auto& all = ctx.frontiers->voxels();

@@ -19,6 +19,8 @@ constexpr float kInfF = std::numeric_limits<float>::infinity();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A step into a cell passable only by the escape rule costs this many times its length.
 constexpr double kEscapePenalty = 20.0;
+// Changes invalidate passability by cubes of 2^kDirtyBits voxels.
+constexpr int kDirtyBits = 2;
 // m: the body box grown by this keeps off every voxel along a segment, checked this often.
 constexpr double kBodyMargin = 0.02;
 constexpr double kBodyStep = 0.05;
@@ -105,8 +107,10 @@ void GridSearch::set_grid(const map::StateGrid* grid) {
 }
 
 void GridSearch::note_changes(const std::vector<map::VoxelChange>& changes) {
+  // By cubes of kDirtyBits^3 voxels, not map blocks: a change invalidates what lies within the
+  // ESDF's reach of its cube, and a 16^3 block grown by that reach is four times the volume.
   for (const map::VoxelChange& c : changes) {
-    const VoxelKey b = map::block_of(c.key);
+    const VoxelKey b{c.key.x >> kDirtyBits, c.key.y >> kDirtyBits, c.key.z >> kDirtyBits};
     dirty_coarse_.insert(b);
     dirty_fine_.insert(b);
   }
@@ -186,14 +190,16 @@ void GridSearch::prepare(Lattice& l) {
   dirty.clear();
 }
 
-void GridSearch::invalidate(Lattice& l, const VoxelKey& block) {
+void GridSearch::invalidate(Lattice& l, const VoxelKey& block) {  // block: a 4^3 cube (kDirtyBits)
   // A voxel changes the ESDF of centres within the checker's cap, and a cell reads the 8 centres
   // around its point: everything within cap + a cell of the block's voxels.
   const double res = grid_->resolution();
-  const int r = static_cast<int>(std::ceil((checker_.cached_cap() + (l.stride + 1) * res) / res));
-  const VoxelKey v0{block.x * map::kBlockSize - r, block.y * map::kBlockSize - r, block.z * map::kBlockSize - r};
-  const VoxelKey v1{block.x * map::kBlockSize + map::kBlockMask + r, block.y * map::kBlockSize + map::kBlockMask + r,
-                    block.z * map::kBlockSize + map::kBlockMask + r};
+  // A cell's class compares its ESDF with passage_clearance at most; a voxel farther than that
+  // plus the interpolation's reach (a voxel) and the cell's own extent cannot change it.
+  const int r = static_cast<int>(std::ceil((collision_.passage_clearance + (l.stride + 1) * res) / res));
+  constexpr int kSize = 1 << kDirtyBits;
+  const VoxelKey v0{block.x * kSize - r, block.y * kSize - r, block.z * kSize - r};
+  const VoxelKey v1{block.x * kSize + kSize - 1 + r, block.y * kSize + kSize - 1 + r, block.z * kSize + kSize - 1 + r};
   const int x0 = std::max(floor_div(v0.x, l.stride) - l.origin.x, 0),
             x1 = std::min(floor_div(v1.x, l.stride) - l.origin.x, l.nx - 1);
   const int y0 = std::max(floor_div(v0.y, l.stride) - l.origin.y, 0),

@@ -102,7 +102,7 @@ class GridSearch {
   Eigen::Vector3d point(const Lattice& l, const map::VoxelKey& c) const;
   // The grid's known box (padded) fits in the lattice; pending changes are applied.
   void prepare(Lattice& l);
-  void invalidate(Lattice& l, const map::VoxelKey& block);
+  void invalidate(Lattice& l, const map::VoxelKey& cube);  // a changed 4^3 cube of voxels
   uint8_t cls(Lattice& l, int64_t i);
   // Passability with the escape zone around `source` (when escape).
   uint8_t passable(Lattice& l, int64_t i, const Eigen::Vector3d& source, bool escape);
@@ -122,7 +122,7 @@ class GridSearch {
   double low_penalty_;
   const map::StateGrid* grid_ = nullptr;
   Lattice coarse_, fine_;
-  std::set<map::VoxelKey> dirty_coarse_, dirty_fine_;  // blocks changed since each lattice looked
+  std::set<map::VoxelKey> dirty_coarse_, dirty_fine_;  // 4^3 cubes changed since each lattice looked
   std::unordered_map<int64_t, uint8_t> escape_cache_;  // this search's escape-zone answers
   // The kept tree: its source, and the coarse lattice's g and parent when it was searched.
   bool tree_valid_ = false;
