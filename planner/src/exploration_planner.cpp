@@ -308,6 +308,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     }
   }
   controller_trigger_ = controller_rejected_ = false;
+  ctx.need_goal = need;
 
   const bool run = need || !strategy_->receding_horizon();
   PlanOutcome o;

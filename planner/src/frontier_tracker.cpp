@@ -11,6 +11,7 @@ FrontierTracker::FrontierTracker(double cluster_size) : cluster_size_(cluster_si
 
 void FrontierTracker::clear() {
   frontier_.clear();
+  bits_.clear();
   cells_.clear();
 }
 
@@ -24,6 +25,7 @@ VoxelKey FrontierTracker::cell_of(const VoxelKey& k) const {
 void FrontierTracker::set(const VoxelKey& k, bool frontier) {
   if (frontier) {
     if (!frontier_.insert(k).second) return;
+    bits_.insert(k);
     Cell& c = cells_[cell_of(k)];
     ++c.voxels;
     c.sx += k.x;
@@ -31,6 +33,7 @@ void FrontierTracker::set(const VoxelKey& k, bool frontier) {
     c.sz += k.z;
   } else {
     if (frontier_.erase(k) == 0) return;
+    bits_.erase(k);
     auto it = cells_.find(cell_of(k));
     if (it == cells_.end()) return;
     Cell& c = it->second;

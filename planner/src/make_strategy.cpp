@@ -1,5 +1,6 @@
 #include "semx/planner/aep_strategy.hpp"
 #include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/nbv_strategy.hpp"
 #include "semx/planner/strategy.hpp"
 
@@ -15,6 +16,8 @@ std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
       return std::make_unique<NbvStrategy>(config);
     case PlannerKind::kAep:
       return std::make_unique<AepStrategy>(config);
+    case PlannerKind::kFuel:
+      return std::make_unique<FuelStrategy>(config);
   }
   return nullptr;
 }

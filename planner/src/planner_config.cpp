@@ -16,6 +16,8 @@ const char* to_string(PlannerKind k) {
       return "nbv";
     case PlannerKind::kAep:
       return "aep";
+    case PlannerKind::kFuel:
+      return "fuel";
   }
   return "?";
 }
@@ -25,7 +27,8 @@ PlannerKind parse_planner_kind(const std::string& name) {
   if (name == "dep") return PlannerKind::kDep;
   if (name == "nbv") return PlannerKind::kNbv;
   if (name == "aep") return PlannerKind::kAep;
-  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep)");
+  if (name == "fuel") return PlannerKind::kFuel;
+  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep, fuel)");
 }
 
 double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
@@ -47,7 +50,7 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep"});
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 
@@ -151,6 +154,35 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   a.get("radius", c.aep.radius, 0.1, 100.0);
   a.get("cache_radius", c.aep.cache_radius, 0.0, 100.0);
   a.get("g_zero", c.aep.g_zero, 0.0, 1e12);
+
+  auto f = m.child("fuel");
+  FuelConfig& fu = c.fuel;
+  f.get("min_cluster_voxels", fu.min_cluster_voxels, 1, 1000000);
+  f.get("major_cluster_voxels", fu.major_cluster_voxels, 1, 1000000000);
+  f.get("major_coverage", fu.major_coverage, 0.0, 1e9);
+  f.get("min_frontier_z", fu.min_frontier_z, -1000.0, 1000.0);
+  f.get("split_radius", fu.split_radius, 0.1, 100.0);
+  f.get("view_radius_min", fu.view_radius_min, 0.0, 100.0);
+  f.get("view_radius_max", fu.view_radius_max, 0.0, 100.0);
+  if (fu.view_radius_max < fu.view_radius_min) f.fail("view_radius_max", "must not be below view_radius_min");
+  f.get("view_radius_steps", fu.view_radius_steps, 1, 100);
+  f.get("view_angles", fu.view_angles, 1, 3600);
+  f.get("view_height_step", fu.view_height_step, 0.0, 100.0);
+  f.get("coverage_cells", fu.coverage_cells, 1, 100000);
+  f.get("min_coverage", fu.min_coverage, 0.0, 1e9);
+  f.get("min_view_distance", fu.min_view_distance, 0.0, 100.0);
+  f.get("direction_weight", fu.direction_weight, 0.0, 100.0);
+  f.get("refine_clusters", fu.refine_clusters, 1, 100);
+  f.get("refine_radius", fu.refine_radius, 0.0, 1000.0);
+  f.get("top_views", fu.top_views, 1, 10000);
+  f.get("max_decay", fu.max_decay, 0.0, 1.0);
+  f.get("exact_tour_max", fu.exact_tour_max, 0, 14);  // 2^14 x 14 states
+  f.get("covered_fraction", fu.covered_fraction, 0.0, 1.0);
+  f.get("replan_period", fu.replan_period, 0.0, 3600.0);
+  f.get("switch_margin", fu.switch_margin, 0.0, 1.0);
+  f.get("search_step", fu.search_step, 1, 8);
+  f.get("low_clearance_penalty", fu.low_clearance_penalty, 0.0, 100.0);
+  f.get("cost_budget", fu.cost_budget, 1000, 100000000);
 }
 
 }  // namespace semx::planner

@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
                 &semantic_weight)
         .option("coverage-period", "S",
                 "simulated seconds between coverage samples, the resolution of "
-                "run_time_to_85 (default 1)",
+                "run_time_to_85 and run_time_to_95 (default 1)",
                 &coverage_period)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override a planner config key", &overrides)
@@ -188,8 +188,8 @@ int main(int argc, char** argv) {
 
     std::vector<double> cycle_cpu_ms, cycle_ms, sample_ms, connect_ms, gain_ms, search_ms, charged_ms, evals;
     std::vector<CycleCounters> counters;
-    double coverage = 0, time_s = 0, distance = 0, time_85 = 0, objects_time = 0;
-    int64_t reached_85 = 0, objects_done = 0, objects_completed = 0;
+    double coverage = 0, time_s = 0, distance = 0, time_85 = 0, time_95 = 0, objects_time = 0;
+    int64_t reached_85 = 0, reached_95 = 0, objects_done = 0, objects_completed = 0;
     int64_t collisions = 0, done = 0, paths = 0;
     const auto wall0 = std::chrono::steady_clock::now();
     for (int64_t run = 0; run < runs; ++run) {
@@ -232,10 +232,11 @@ int main(int argc, char** argv) {
           const StatusReport& s = *out.status;
           std::printf(
               "t=%7.2f it=%4lld %-10s nodes=%4d ms=%6.2f (s %.2f c %.2f g %.2f q %.2f) evals=%lld "
-              "charged=%.1fms %s\n",
+              "settled=%lld charged=%.1fms %s\n",
               t, static_cast<long long>(s.iteration), to_string(s.state), s.num_nodes, s.counters.total_ms,
               s.counters.sample_ms, s.counters.connect_ms, s.counters.gain_ms, s.counters.search_ms,
-              static_cast<long long>(s.counters.gain_evaluations), 1e3 * s.charged_s, s.reason.c_str());
+              static_cast<long long>(s.counters.gain_evaluations), static_cast<long long>(s.counters.search_settled),
+              1e3 * s.charged_s, s.reason.c_str());
         }
       });
       if (kernels && run == 0) time_kernels(sim.known(), c);
@@ -258,20 +259,28 @@ int main(int argc, char** argv) {
         ++objects_done;
       }
       std::printf("run_time_to_85: %.1f s\n", r.time_85);
-      std::printf("run_time_to_95: %.1f s\n", r.time_95);
       std::printf("run_end_game: %.1f s of %.1f s (settled at %.1f s, coverage %.2f %%)\n",
                   r.time_s - r.time_settled, r.time_s, r.time_settled, 100.0 * r.coverage);
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
         ++reached_85;
       }
+      std::printf("run_time_to_95: %.1f s\n", r.time_95);
+      std::printf("run_coverage: %.2f %%\n", 100.0 * r.coverage);
+      std::printf("run_collisions: %lld steps\n", static_cast<long long>(r.collisions));
+      std::printf("run_end: %s at %.1f s\n", r.done ? "DONE" : "stopped", r.time_s);
+      if (r.time_95 >= 0) {
+        time_95 += r.time_95;
+        ++reached_95;
+      }
       time_s += r.time_s;
       distance += r.distance;
       collisions += r.collisions;
       paths += r.paths;
       done += r.done ? 1 : 0;
-      if (verbose)
-        for (const auto& [t, cov] : r.coverage_curve) std::printf("coverage t=%.1f %.3f %%\n", t, 100.0 * cov);
+      if (verbose) {
+        for (const auto& [t, c] : r.coverage_curve) std::printf("coverage_at %.1f s: %.2f %%\n", t, 100.0 * c);
+      }
       if (verbose)
         std::printf("run %lld: %s after %.1f s: %s\n", static_cast<long long>(run),
                     r.done ? "DONE" : "stopped", r.time_s, r.reason.c_str());
@@ -301,6 +310,7 @@ int main(int argc, char** argv) {
     std::printf("done: %lld explorations\n", static_cast<long long>(done));
     std::printf("exploration_time: %.1f s\n", time_s / n);
     if (reached_85 > 0) std::printf("time_to_85: %.1f s\n", time_85 / static_cast<double>(reached_85));
+    if (reached_95 > 0) std::printf("time_to_95: %.1f s\n", time_95 / static_cast<double>(reached_95));
     std::printf("distance: %.1f m\n", distance / n);
     if (semantic_weight > 0) {
       std::printf("objects_total: %zu objects\n", world->objects().size());

@@ -85,6 +85,31 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(aep.radius);
   SAME(aep.cache_radius);
   SAME(aep.g_zero);
+  SAME(fuel.min_cluster_voxels);
+  SAME(fuel.major_cluster_voxels);
+  SAME(fuel.major_coverage);
+  SAME(fuel.min_frontier_z);
+  SAME(fuel.split_radius);
+  SAME(fuel.view_radius_min);
+  SAME(fuel.view_radius_max);
+  SAME(fuel.view_radius_steps);
+  SAME(fuel.view_angles);
+  SAME(fuel.view_height_step);
+  SAME(fuel.coverage_cells);
+  SAME(fuel.min_coverage);
+  SAME(fuel.min_view_distance);
+  SAME(fuel.direction_weight);
+  SAME(fuel.refine_clusters);
+  SAME(fuel.refine_radius);
+  SAME(fuel.top_views);
+  SAME(fuel.max_decay);
+  SAME(fuel.exact_tour_max);
+  SAME(fuel.covered_fraction);
+  SAME(fuel.replan_period);
+  SAME(fuel.switch_margin);
+  SAME(fuel.search_step);
+  SAME(fuel.low_clearance_penalty);
+  SAME(fuel.cost_budget);
 #undef SAME
 }
 
@@ -135,7 +160,9 @@ TEST(PlannerConfig, OverridesAndErrors) {
   EXPECT_THROW(load_config<PlannerConfig>("", {"gain.max_range=0.2"}), ConfigError);  // below min_range
   EXPECT_THROW(load_config<PlannerConfig>("", {"collision.vehicle_size=[1, 2]"}), ConfigError);
   EXPECT_THROW(parse_planner_kind("DEP"), std::invalid_argument);
-  for (const char* name : {"semantic-dep", "dep", "nbv", "aep"})
+  EXPECT_THROW(load_config<PlannerConfig>("", {"fuel.view_radius_max=1.0"}), ConfigError);  // below min
+  EXPECT_EQ(load_config<PlannerConfig>("", {"planner=fuel"}).kind(), PlannerKind::kFuel);
+  for (const char* name : {"semantic-dep", "dep", "nbv", "aep", "fuel"})
     EXPECT_STREQ(to_string(parse_planner_kind(name)), name);
 }
 

@@ -1,5 +1,8 @@
 #include "semx/fixtures/exploration_sim.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
 #include <cmath>
 
 #include "semx/core/angles.hpp"
@@ -111,12 +114,22 @@ ExplorationSimResult ExplorationSim::run(
   for (int64_t i = 1; i <= steps; ++i) {
     const double t = i * options_.dt;
     move(options_.dt);
-    if (world_.collides(pose_.position, body)) ++r.collisions;
+    if (world_.collides(pose_.position, body)) {
+      ++r.collisions;
+      if (std::getenv("SEMX_SIM_DEBUG"))
+        std::fprintf(stderr, "collision t=%.2f at (%.3f %.3f %.3f) yaw %.2f path %zu/%zu\n", t, pose_.position.x(),
+                     pose_.position.y(), pose_.position.z(), pose_.yaw, next_waypoint_, path_.waypoints.size());
+      if (std::getenv("SEMX_SIM_DEBUG"))
+        for (const auto& w : path_.waypoints) std::fprintf(stderr, "   wp (%.3f %.3f %.3f)\n", w.x(), w.y(), w.z());
+    }
     if (t + 1e-9 >= next_observe) {
       observe();
       update_regions(t, r);
       next_observe += options_.observe_period;
     }
+    if (std::getenv("SEMX_SIM_TRACE") && i % 5 == 0)
+      std::fprintf(stderr, "pose t=%.2f %.2f %.2f %.2f yaw %.2f\n", t, pose_.position.x(), pose_.position.y(),
+                   pose_.position.z(), pose_.yaw);
     pose_.utime = static_cast<int64_t>(std::llround(t * 1e6));
     planner_.set_pose(pose_);
     if (holding_ && planner_.plan_id() > 0)
@@ -139,6 +152,7 @@ ExplorationSimResult ExplorationSim::run(
       const double c = world_.coverage(known_);
       r.coverage_curve.emplace_back(t, c);
       if (r.time_85 < 0 && c >= 0.85) r.time_85 = t;
+      if (r.time_95 < 0 && c >= 0.95) r.time_95 = t;
       next_coverage += options_.coverage_period;
     }
     if (on_step) on_step(t, out);
@@ -153,9 +167,9 @@ ExplorationSimResult ExplorationSim::run(
   r.coverage = world_.coverage(known_);
   r.coverage_curve.emplace_back(r.time_s, r.coverage);
   if (r.time_85 < 0 && r.coverage >= 0.85) r.time_85 = r.time_s;
+  if (r.time_95 < 0 && r.coverage >= 0.95) r.time_95 = r.time_s;
   // As the evaluator defines them (run_metrics.hpp), on this loop's coverage samples.
   for (const auto& [t, c] : r.coverage_curve) {
-    if (r.time_95 < 0 && c >= 0.95) r.time_95 = t;
     if (r.time_settled < 0 && c >= r.coverage - 0.005) r.time_settled = t;
   }
   if (!r.done) r.reason = planner_.last_status().reason;

@@ -49,6 +49,10 @@ class CollisionChecker {
   bool root_edge_free(const Eigen::Vector3d& root, const Eigen::Vector3d& b) const;
   // The bare vehicle box at p overlaps no occupied voxel (unknown allowed).
   bool vehicle_free(const Eigen::Vector3d& p) const;
+  // No occupied voxel (or unknown, when unknown_is_occupied) overlaps the open box p ± half.
+  bool box_free(const Eigen::Vector3d& p, const Eigen::Vector3d& half, bool unknown_is_occupied) const {
+    return region_free(p, half, 0.0, unknown_is_occupied);
+  }
   // The controller's ESDF value at p as it would read it on this map with unknown voxels counted
   // as obstacles (the mapper's definition: centre-to-centre distance to the nearest obstacle voxel
   // minus half a voxel, at voxel centres; trilinear between them). Exact up to `cap`; above it a

@@ -15,6 +15,7 @@
 
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
+#include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
 
@@ -27,7 +28,11 @@ class FrontierTracker {
   void clear();
 
   size_t size() const { return frontier_.size(); }
-  bool contains(const map::VoxelKey& k) const { return frontier_.count(k) != 0; }
+  bool contains(const map::VoxelKey& k) const { return bits_.contains(k); }
+  // Every frontier voxel (unordered: callers that decide on them sort first).
+  const std::unordered_set<map::VoxelKey>& voxels() const { return frontier_; }
+  // The same as block bit masks, for callers that look up many voxels near each other.
+  const VoxelSet& bits() const { return bits_; }
 
   struct Cluster {
     map::VoxelKey cell;      // cell coordinates (floor(voxel centre / cluster_size))
@@ -49,6 +54,7 @@ class FrontierTracker {
   double cluster_size_;
   double resolution_ = 0.0;
   std::unordered_set<map::VoxelKey> frontier_;
+  VoxelSet bits_;  // frontier_ again, one bit per voxel
   std::map<map::VoxelKey, Cell> cells_;
 };
 

@@ -94,9 +94,12 @@ class GainEvaluator {
   // turn and the window together span them). sweep_gains() fills this for every window at once.
   double sweep_gain(const NodeGain& g, double from_yaw, int to_window) const;
   void sweep_gains(const NodeGain& g, double from_yaw, std::vector<double>& out) const;
+  // The sensor model's range and vertical field of view for a voxel centre at `offset` from the
+  // camera (any azimuth: the yaw windows decide the horizontal field); FUEL's viewpoint coverage
+  // uses it too, so both planners see with the same camera.
+  bool in_sector(const Eigen::Vector3d& offset) const;
 
  private:
-  bool in_sector(const Eigen::Vector3d& offset) const;
   // Bin of an offset's azimuth, starting the search from a guess (the ray's bin): exact, without
   // atan2 (cross products with the bins' boundary directions).
   int bin_near(const Eigen::Vector3d& offset, int guess) const;

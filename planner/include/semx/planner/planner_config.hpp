@@ -14,12 +14,13 @@
 
 namespace semx::planner {
 
-// The four planners of the paper's comparison (DESIGN.md §4).
+// The four planners of the paper's comparison (DESIGN.md §4), and FUEL as a later baseline.
 enum class PlannerKind {
   kSemanticDep,  // DEP roadmap + semantic reward (the paper's method)
   kDep,          // the same roadmap, semantics off
   kNbv,          // receding-horizon RRT next-best-view (Bircher 2016)
   kAep,          // RRT* with cached gains and frontier fallback (Selin 2019)
+  kFuel,         // frontier clusters, a global tour over their viewpoints (Zhou 2021)
 };
 const char* to_string(PlannerKind k);
 // Throws std::invalid_argument for an unknown name.
@@ -216,8 +217,76 @@ struct AepConfig {
   double g_zero = 1000.0;
 };
 
+// FUEL (Zhou et al., RA-L 2021; fuel_strategy.hpp). The defaults are FUEL's own
+// (exploration_manager/launch/algorithm.xml) where this map allows them; docs/planner.md, "FUEL",
+// says where and why they differ.
+struct FuelConfig {
+  // Frontier voxels a connected group needs to be a cluster (and to be visited at all).
+  int min_cluster_voxels = 30;
+  // While any cluster has major_cluster_voxels voxels and a viewpoint that sees major_coverage of
+  // them, the tour visits only such clusters: FUEL's own thresholds (cluster_min 100 cells,
+  // min_visib_num 15 cells of 0.3 m), below which FUEL drops a cluster for good. Smaller ones are
+  // visited after them, so the end of the exploration covers what the other planners cover
+  // (docs/planner.md, "FUEL").
+  int major_cluster_voxels = 100;
+  double major_coverage = 100.0;
+  // m: frontier voxels with a centre below this height are not clustered (FUEL's expandFrontier
+  // drops cells below 0.4 m as noise close to the ground).
+  double min_frontier_z = 0.4;
+  // m: a cluster with a voxel farther than this horizontally from its mean is split in two along
+  // its principal axis (FUEL's cluster_size_xy), so one viewpoint can see most of it.
+  double split_radius = 2.0;
+  // Viewpoint candidates on circles around a cluster's mean (FUEL's candidate_rmin, rmax, rnum,
+  // dphi): radii from view_radius_min to view_radius_max in view_radius_steps steps, and
+  // view_angles directions on each.
+  double view_radius_min = 1.5;  // m
+  double view_radius_max = 2.5;  // m
+  int view_radius_steps = 3;
+  int view_angles = 24;
+  // m: candidates are at the cluster's mean height (clamped to sampling.z_min..z_max); when none
+  // of them is a viewpoint, also this far above and below it.
+  double view_height_step = 0.5;
+  // At most this many of a cluster's voxels (spread over it) are tested for visibility; a
+  // candidate's coverage is the share of them it sees times the cluster's voxels (FUEL
+  // down-samples its cells by 3 per axis).
+  int coverage_cells = 32;
+  // Voxels of the cluster a candidate must see (in the camera's field of view, a line of sight
+  // through known free voxels) to be a viewpoint (FUEL's min_visib_num).
+  double min_coverage = 10.0;
+  // A viewpoint nearer than this to the vehicle is not a cluster's tour representative while
+  // another is (FUEL's min_candidate_dist).
+  double min_view_distance = 0.75;  // m
+  // s per rad: the first leg of a tour costs this much more per radian between the vehicle's
+  // velocity and the direction to its viewpoint (FUEL's w_dir, motion consistency), so a replan
+  // does not turn the vehicle back for a target about as cheap as the one ahead.
+  double direction_weight = 1.5;
+  // Local refinement (FUEL's refined_num, refined_radius, top_view_num, max_decay): the first
+  // refine_clusters clusters of the tour, up to the first beyond refine_radius (at least two),
+  // each choosing among its top_views viewpoints with coverage above max_decay x its best.
+  int refine_clusters = 7;
+  double refine_radius = 5.0;  // m
+  int top_views = 15;
+  double max_decay = 0.8;
+  // Tours over at most this many clusters are solved exactly (dynamic programming); larger ones
+  // by nearest neighbour, 2-opt and Or-opt (FUEL calls LKH).
+  int exact_tour_max = 11;
+  // Replan when this share of the target cluster's voxels is no longer frontier (FUEL's
+  // min_view_finish_fraction), and every replan_period s of message time (FUEL's
+  // thresh_replan3), then switching target only for a tour this much cheaper than keeping it.
+  double covered_fraction = 0.2;
+  double replan_period = 1.5;  // s, 0: no periodic replan
+  double switch_margin = 0.1;
+  // The grid search (grid_search.hpp): coarse cells of search_step voxels for travel costs, and
+  // how much more a step costs where the clearance is below collision.passage_clearance.
+  int search_step = 2;
+  double low_clearance_penalty = 1.0;
+  // Settled coarse cells per cycle for the clusters' travel costs at most; the rest wait for the
+  // next cycle (estimated meanwhile), so a burst of new clusters does not stall one cycle.
+  int cost_budget = 120000;
+};
+
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -230,6 +299,7 @@ struct PlannerConfig {
   ChargeConfig charge;
   NbvConfig nbv;
   AepConfig aep;
+  FuelConfig fuel;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };

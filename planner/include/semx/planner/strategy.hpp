@@ -1,6 +1,7 @@
 // What the main loop (ExplorationPlanner) asks of a planning method: one cycle's best goal and
-// the path to it. DEP (with or without semantics), NBV and AEP implement it (dep_strategy.hpp,
-// nbv_strategy.hpp, aep_strategy.hpp) on the same map, sensor model and collision checks.
+// the path to it. DEP (with or without semantics), NBV, AEP and FUEL implement it (dep_strategy.hpp,
+// nbv_strategy.hpp, aep_strategy.hpp, fuel_strategy.hpp) on the same map, sensor model and
+// collision checks.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,10 +30,14 @@ struct PlanContext {
   // Voxels that gains ignore (seen as unobservable after a visit; exploration_planner.hpp).
   const VoxelSet* unobservable = nullptr;
   int64_t cycle = 0;
-  bool recovering = false;
+  bool recovering = false;  // the previous cycles found no goal: sample for frontiers
   // The gain a goal must have: gain.min_gain, raised by the main loop when recent goals delivered
   // less than their gain promised (loop.yield_goals).
-  double min_gain = 0.0;  // the previous cycles found no goal: sample for frontiers
+  double min_gain = 0.0;
+  // The main loop will fly this cycle's goal whatever it is (no goal yet, the goal was reached,
+  // the path is blocked, the controller gave up on it); otherwise it keeps the current goal unless
+  // goal_score() says otherwise. FUEL decides on it whether to replan its tour.
+  bool need_goal = false;
   core::SplitMixRng* rng = nullptr;
   CycleCounters* counters = nullptr;
 };

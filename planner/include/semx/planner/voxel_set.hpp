@@ -28,10 +28,44 @@ class VoxelSet {
     ++size_;
     return true;
   }
+  // True when k was in the set. A block whose last member leaves keeps its (empty) mask, so the
+  // masks a Cursor points to stay valid until clear().
+  bool erase(const map::VoxelKey& k) {
+    const auto it = blocks_.find(map::block_of(k));
+    if (it == blocks_.end()) return false;
+    const int i = map::local_index(k);
+    uint64_t& word = it->second[static_cast<size_t>(i >> 6)];
+    const uint64_t bit = uint64_t{1} << (i & 63);
+    if (!(word & bit)) return false;
+    word &= ~bit;
+    --size_;
+    return true;
+  }
   bool contains(const map::VoxelKey& k) const {
     const Mask* m = block_mask(map::block_of(k));
     return m && test(*m, map::local_index(k));
   }
+  // contains() for lookups that mostly stay in one block (a region growing over the frontier):
+  // the last block's mask is kept, so most lookups read one bit. Valid until the set's clear().
+  class Cursor {
+   public:
+    explicit Cursor(const VoxelSet& s) : set_(&s) {}
+    bool contains(const map::VoxelKey& k) {
+      const map::VoxelKey b = map::block_of(k);
+      if (!valid_ || b != block_) {
+        mask_ = set_->block_mask(b);
+        block_ = b;
+        valid_ = true;
+      }
+      return mask_ && test(*mask_, map::local_index(k));
+    }
+
+   private:
+    const VoxelSet* set_;
+    const Mask* mask_ = nullptr;
+    map::VoxelKey block_;
+    bool valid_ = false;
+  };
   // The members in the block with block coordinates `block`; null when it has none.
   const Mask* block_mask(const map::VoxelKey& block) const {
     const auto it = blocks_.find(block);

@@ -1,0 +1,37 @@
+// The global tour of FUEL (Zhou et al. 2021, §V-A): an asymmetric travelling-salesman problem over
+// the vehicle's pose (node 0) and one viewpoint per frontier cluster (nodes 1..n-1), with every
+// return to node 0 free, so the cheapest closed tour is the cheapest open path from the vehicle
+// through every viewpoint. FUEL hands the matrix to LKH; here tours over at most `exact_max`
+// viewpoints are solved exactly (Held-Karp dynamic programming, 2^m m^2 steps: 0.6 M at m = 12),
+// larger ones by nearest neighbour then 2-opt and Or-opt moves until none improves.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace semx::planner {
+
+// cost[i * n + j]: travel cost from node i to node j (the diagonal and column 0 are ignored).
+struct TourProblem {
+  int n = 0;  // nodes, the start included
+  std::vector<double> cost;
+  double at(int i, int j) const {
+    return cost[static_cast<std::size_t>(i) * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
+  }
+};
+
+struct Tour {
+  std::vector<int> order;  // nodes 1..n-1 in visiting order
+  double cost = 0.0;       // of the open path 0 -> order[0] -> ... -> order.back()
+  bool exact = false;      // solved by dynamic programming (optimal)
+};
+
+// The cost of visiting `order` from node 0.
+double open_path_cost(const TourProblem& p, const std::vector<int>& order);
+// The best open tour; with `first` >= 1 the tour must visit that node first.
+Tour solve_open_tour(const TourProblem& p, int exact_max, int first = -1);
+// The two methods on their own (tests compare them with brute force).
+Tour exact_open_tour(const TourProblem& p, int first = -1);
+Tour heuristic_open_tour(const TourProblem& p, int first = -1);
+
+}  // namespace semx::planner

@@ -1,0 +1,145 @@
+#include "semx/planner/tour_solver.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace semx::planner {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
+double open_path_cost(const TourProblem& p, const std::vector<int>& order) {
+  double c = 0.0;
+  int prev = 0;
+  for (int v : order) {
+    c += p.at(prev, v);
+    prev = v;
+  }
+  return c;
+}
+
+Tour exact_open_tour(const TourProblem& p, int first) {
+  Tour t;
+  t.exact = true;
+  const int m = p.n - 1;  // nodes to visit, node i + 1 is bit i
+  if (m <= 0) return t;
+  const size_t states = size_t{1} << m;
+  // best[mask * m + j]: the cheapest path from node 0 through the nodes of mask ending at j.
+  std::vector<double> best(states * static_cast<size_t>(m), kInf);
+  std::vector<int> from(states * static_cast<size_t>(m), -1);
+  for (int j = 0; j < m; ++j) {
+    if (first >= 1 && j != first - 1) continue;
+    best[(size_t{1} << j) * static_cast<size_t>(m) + static_cast<size_t>(j)] = p.at(0, j + 1);
+  }
+  for (size_t mask = 1; mask < states; ++mask) {
+    for (int j = 0; j < m; ++j) {
+      if (!(mask >> j & 1u)) continue;
+      const double c = best[mask * static_cast<size_t>(m) + static_cast<size_t>(j)];
+      if (c == kInf) continue;
+      for (int k = 0; k < m; ++k) {
+        if (mask >> k & 1u) continue;
+        const size_t next = (mask | (size_t{1} << k)) * static_cast<size_t>(m) + static_cast<size_t>(k);
+        const double d = c + p.at(j + 1, k + 1);
+        if (d < best[next]) {
+          best[next] = d;
+          from[next] = j;
+        }
+      }
+    }
+  }
+  const size_t full = states - 1;
+  int end = -1;
+  double cost = kInf;
+  for (int j = 0; j < m; ++j) {
+    const double c = best[full * static_cast<size_t>(m) + static_cast<size_t>(j)];
+    if (c < cost) cost = c, end = j;
+  }
+  if (end < 0) return t;
+  size_t mask = full;
+  for (int j = end; j >= 0;) {
+    t.order.push_back(j + 1);
+    const int prev = from[mask * static_cast<size_t>(m) + static_cast<size_t>(j)];
+    mask &= ~(size_t{1} << j);
+    j = prev;
+  }
+  std::reverse(t.order.begin(), t.order.end());
+  t.cost = cost;
+  return t;
+}
+
+Tour heuristic_open_tour(const TourProblem& p, int first) {
+  Tour t;
+  const int n = p.n;
+  if (n <= 1) return t;
+  // Nearest neighbour from the start (through `first` when given).
+  std::vector<bool> used(static_cast<size_t>(n), false);
+  used[0] = true;
+  int cur = 0;
+  if (first >= 1) {
+    t.order.push_back(first);
+    used[static_cast<size_t>(first)] = true;
+    cur = first;
+  }
+  while (static_cast<int>(t.order.size()) < n - 1) {
+    int next = -1;
+    for (int j = 1; j < n; ++j) {
+      if (!used[static_cast<size_t>(j)] && (next < 0 || p.at(cur, j) < p.at(cur, next))) next = j;
+    }
+    t.order.push_back(next);
+    used[static_cast<size_t>(next)] = true;
+    cur = next;
+  }
+  // Local moves on the order, each kept when it lowers the cost (costs are asymmetric, so a move
+  // is valued by the whole path it makes; O(n) per move, O(n^3) per pass, n a few dozen here).
+  const int lo = first >= 1 ? 1 : 0;  // a forced first node stays first
+  const int len = static_cast<int>(t.order.size());
+  double cost = open_path_cost(p, t.order);
+  std::vector<int> trial;
+  for (int pass = 0; pass < 50; ++pass) {
+    bool improved = false;
+    // 2-opt: reverse order[i..j].
+    for (int i = lo; i < len - 1; ++i) {
+      for (int j = i + 1; j < len; ++j) {
+        trial = t.order;
+        std::reverse(trial.begin() + i, trial.begin() + j + 1);
+        const double c = open_path_cost(p, trial);
+        if (c < cost - 1e-9) {
+          t.order.swap(trial);
+          cost = c;
+          improved = true;
+        }
+      }
+    }
+    // Or-opt: move a run of 1-3 nodes elsewhere, in its own direction.
+    for (int run = 1; run <= 3; ++run) {
+      for (int i = lo; i + run <= len; ++i) {
+        for (int to = lo; to <= len - run; ++to) {
+          if (to == i) continue;
+          trial = t.order;
+          std::vector<int> seg(trial.begin() + i, trial.begin() + i + run);
+          trial.erase(trial.begin() + i, trial.begin() + i + run);
+          trial.insert(trial.begin() + to, seg.begin(), seg.end());
+          const double c = open_path_cost(p, trial);
+          if (c < cost - 1e-9) {
+            t.order.swap(trial);
+            cost = c;
+            improved = true;
+          }
+        }
+      }
+    }
+    if (!improved) break;
+  }
+  t.cost = cost;
+  return t;
+}
+
+Tour solve_open_tour(const TourProblem& p, int exact_max, int first) {
+  if (p.n - 1 <= exact_max) return exact_open_tour(p, first);
+  return heuristic_open_tour(p, first);
+}
+
+}  // namespace semx::planner
