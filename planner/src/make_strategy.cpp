@@ -1,6 +1,7 @@
 #include "semx/planner/aep_strategy.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/nbv_strategy.hpp"
+#include "semx/planner/oracle_strategy.hpp"
 #include "semx/planner/strategy.hpp"
 
 namespace semx::planner {
@@ -15,6 +16,8 @@ std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
       return std::make_unique<NbvStrategy>(config);
     case PlannerKind::kAep:
       return std::make_unique<AepStrategy>(config);
+    case PlannerKind::kOracle:
+      return std::make_unique<OracleStrategy>(config);
   }
   return nullptr;
 }

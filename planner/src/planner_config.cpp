@@ -16,6 +16,8 @@ const char* to_string(PlannerKind k) {
       return "nbv";
     case PlannerKind::kAep:
       return "aep";
+    case PlannerKind::kOracle:
+      return "oracle";
   }
   return "?";
 }
@@ -25,7 +27,8 @@ PlannerKind parse_planner_kind(const std::string& name) {
   if (name == "dep") return PlannerKind::kDep;
   if (name == "nbv") return PlannerKind::kNbv;
   if (name == "aep") return PlannerKind::kAep;
-  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep)");
+  if (name == "oracle") return PlannerKind::kOracle;
+  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep, oracle)");
 }
 
 double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
@@ -47,7 +50,7 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep"});
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "oracle"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 
@@ -149,6 +152,17 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   a.get("radius", c.aep.radius, 0.1, 100.0);
   a.get("cache_radius", c.aep.cache_radius, 0.0, 100.0);
   a.get("g_zero", c.aep.g_zero, 0.0, 1e12);
+
+  auto o = m.child("oracle");
+  o.get("spacing", c.oracle.spacing, 0.05, 10.0);
+  o.get("height_step", c.oracle.height_step, 0.05, 10.0);
+  o.get("rays_azimuth", c.oracle.rays_azimuth, 8, 4096);
+  o.get("rays_elevation", c.oracle.rays_elevation, 1, 1024);
+  o.get("cover_fraction", c.oracle.cover_fraction, 0.0, 1.0);
+  o.get("preferred_clearance", c.oracle.preferred_clearance, 0.0, 5.0);
+  o.get("clearance_penalty", c.oracle.clearance_penalty, 0.0, 1e6);
+  o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
+  o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
 }
 
 }  // namespace semx::planner

@@ -14,12 +14,15 @@
 
 namespace semx::planner {
 
-// The four planners of the paper's comparison (DESIGN.md §4).
+// The four planners of the paper's comparison (DESIGN.md §4), and a reference that cheats.
 enum class PlannerKind {
   kSemanticDep,  // DEP roadmap + semantic reward (the paper's method)
   kDep,          // the same roadmap, semantics off
   kNbv,          // receding-horizon RRT next-best-view (Bircher 2016)
   kAep,          // RRT* with cached gains and frontier fallback (Selin 2019)
+  // NOT an exploration method: reads the world's ground truth and flies a precomputed tour of
+  // viewpoints that sees it (oracle_strategy.hpp), the physical-limit reference of the bench.
+  kOracle,
 };
 const char* to_string(PlannerKind k);
 // Throws std::invalid_argument for an unknown name.
@@ -206,8 +209,32 @@ struct AepConfig {
   double g_zero = 1000.0;
 };
 
+// The known-map oracle (oracle_strategy.hpp; docs/planner.md, "The known-map oracle"). It knows
+// the world (the evaluator's ground truth), so none of this is exploration: viewpoints on a
+// lattice of the true free space, a greedy set cover of the target set T, a tour through them.
+// The body, clearances, heights (sampling.z_min/z_max), camera and range (gain.*), yaw bins
+// (gain.yaw_bins) and travel time (cost.*) are the other planners'.
+struct OracleConfig {
+  double spacing = 0.4;      // m, horizontal pitch of the lattice of candidate viewpoints
+  double height_step = 0.4;  // m, its vertical pitch, from sampling.z_min up
+  // Visibility rays per candidate: around it (360°) and across the camera's vertical field of
+  // view. 256 x 48 are 1.4° x 1.5° apart, about a voxel at 4 m; the real camera (0.14° a pixel)
+  // sees at least what they see, so what the model misses far away only makes the tour longer.
+  int rays_azimuth = 256;
+  int rays_elevation = 48;
+  // The tour must see this share of what all candidates together see of T (the observable part).
+  double cover_fraction = 0.99;
+  // m: legs keep this far from obstacles where there is room (the path search charges
+  // clearance_penalty per metre flown and per metre below it), so they go through the middle of
+  // doorways and rooms, as far as they can from walls the live map may not know yet.
+  double preferred_clearance = 0.6;
+  double clearance_penalty = 4.0;
+  int exact_tour_max = 12;  // tours of at most this many viewpoints are solved exactly (DP)
+  int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
+};
+
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | oracle
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -220,6 +247,7 @@ struct PlannerConfig {
   ChargeConfig charge;
   NbvConfig nbv;
   AepConfig aep;
+  OracleConfig oracle;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };
