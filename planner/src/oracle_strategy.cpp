@@ -1,6 +1,7 @@
 #include "semx/planner/oracle_strategy.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -73,7 +74,7 @@ struct OracleStrategy::Model {
 
   // The camera: rays from a cell's centre, each a run of steps.
   struct Step {
-    int64_t offset;
+    int32_t offset;  // cell index difference from the ray's origin
     uint32_t free_mask;   // yaw bins that observe the cell when the ray passes through it
     uint32_t hit_mask;    // ... when the ray's return ends in it
     uint32_t valid_mask;  // ... for which a return in it is not nearer than min_range
@@ -81,6 +82,9 @@ struct OracleStrategy::Model {
   std::vector<Step> steps;
   std::vector<uint32_t> ray_begin;
   std::vector<uint32_t> frustum;  // per ray, the bins whose frustum holds it
+  // Per ray, the first step from which a return is never nearer than min_range for any bin
+  // (valid_mask == frustum): only the voxels before it wait to learn whether the ray counts.
+  std::vector<uint32_t> valid_from;
   int bins = 32;
   std::vector<uint32_t> vmask;  // scratch of cast()
   std::vector<int64_t> touched;
@@ -253,7 +257,7 @@ void OracleStrategy::Model::build_rays(const GainConfig& g, const OracleConfig& 
         const double t_exit = t_next[axis];
         const double e = t_entry * res, x = t_exit * res;
         Step s;
-        s.offset = cell[0] + cell[1] * sy + cell[2] * sz;
+        s.offset = static_cast<int32_t>(cell[0] + cell[1] * sy + cell[2] * sz);
         s.free_mask = mask([&](double cb) { return x * cb <= maxr; });
         s.valid_mask = mask([&](double cb) { return e * cb >= minr; });
         s.hit_mask = mask([&](double cb) { return e * cb <= maxr; }) & s.valid_mask;
@@ -262,6 +266,9 @@ void OracleStrategy::Model::build_rays(const GainConfig& g, const OracleConfig& 
         t_next[axis] += t_delta[axis];
         t_entry = t_exit;
       }
+      uint32_t vf = ray_begin.back();
+      while (vf < steps.size() && steps[vf].valid_mask != in) ++vf;
+      valid_from.push_back(vf);
       ray_begin.push_back(static_cast<uint32_t>(steps.size()));
       frustum.push_back(in);
     }
@@ -270,27 +277,48 @@ void OracleStrategy::Model::build_rays(const GainConfig& g, const OracleConfig& 
 
 void OracleStrategy::Model::cast(int64_t o, std::vector<MaskedElement>& out) {
   out.clear();
+  auto mark = [&](int64_t i, uint32_t m) {
+    uint32_t& v = vmask[static_cast<size_t>(i)];
+    if (!v) touched.push_back(i);
+    v |= m;
+  };
   for (size_t r = 0; r + 1 < ray_begin.size(); ++r) {
+    // Near the origin a return may be too near for some bins (min_range), which decides whether
+    // the voxels before it count: they wait in the buffer until the ray's end or valid_from.
     ray_buffer.clear();
+    uint32_t s = ray_begin[r];
+    const uint32_t end = ray_begin[r + 1], vf = valid_from[r];
+    bool ended = false;
     uint32_t valid = frustum[r];
-    for (uint32_t s = ray_begin[r]; s < ray_begin[r + 1]; ++s) {
+    for (; s < end && s < vf; ++s) {
       const Step& st = steps[s];
       const int64_t i = o + st.offset;
       const uint8_t f = flags[static_cast<size_t>(i)];
-      if (f & kBorder) break;  // out of the world: no return
+      if (f & kBorder) {  // out of the world: no return
+        ended = true;
+        break;
+      }
       if (f & kOccupied) {
         valid = st.valid_mask;
         if ((f & kTarget) && st.hit_mask) ray_buffer.emplace_back(i, st.hit_mask);
+        ended = true;
         break;
       }
       if ((f & kTarget) && st.free_mask) ray_buffer.emplace_back(i, st.free_mask);
     }
-    for (const auto& [i, m0] : ray_buffer) {
-      const uint32_t m = m0 & valid;
-      if (!m) continue;
-      uint32_t& v = vmask[static_cast<size_t>(i)];
-      if (!v) touched.push_back(i);
-      v |= m;
+    for (const auto& [i, m] : ray_buffer)
+      if (m & valid) mark(i, m & valid);
+    if (ended) continue;
+    for (; s < end; ++s) {
+      const Step& st = steps[s];
+      const int64_t i = o + st.offset;
+      const uint8_t f = flags[static_cast<size_t>(i)];
+      if (f & kBorder) break;
+      if (f & kOccupied) {
+        if ((f & kTarget) && st.hit_mask) mark(i, st.hit_mask);
+        break;
+      }
+      if ((f & kTarget) && st.free_mask) mark(i, st.free_mask);
     }
   }
   for (int64_t i : touched) {
@@ -412,6 +440,9 @@ void OracleStrategy::reset() {
   tour_.clear();
   tour_elements_.clear();
   holders_.clear();
+  picks_.clear();
+  tour_costs_.clear();
+  tour_order_.clear();
   next_ = 0;
   attempts_ = 0;
   skipped_ = 0;
@@ -445,6 +476,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     return false;
   }
   if (!model_) model_ = std::make_unique<Model>(*truth_, config_);
+  fprintf(stderr, "TIMING model %.1f ms\n", watch.ms());
   Model& m = *model_;
   summary_.target = static_cast<int64_t>(m.targets.size());
 
@@ -497,29 +529,42 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       }
   }
   summary_.candidates = static_cast<int64_t>(m.candidates.size());
+  fprintf(stderr, "TIMING candidates %zu %.1f ms rays %zu steps %zu\n", m.candidates.size(), watch.ms(), m.frustum.size(), m.steps.size());
   if (m.candidates.empty()) {
     summary_.error = "no viewpoint on the true free space the vehicle can reach";
     return false;
   }
 
   // 2-3. What each sees, and the cover.
-  ViewSource source([&](int g, std::vector<MaskedElement>& out) { m.cast(m.candidates[static_cast<size_t>(g)], out); },
-                    static_cast<int>(m.candidates.size()), m.bins);
+  // The cover asks for a candidate's view again whenever one of its bounds comes first: kept, up
+  // to oracle.cache_mb, a view is cast once (the same lists either way).
+  m.observable.assign(m.targets.size(), 0);
+  std::vector<std::vector<MaskedElement>> cache(m.candidates.size());
+  std::vector<uint8_t> cached(m.candidates.size(), 0);
+  const size_t budget = static_cast<size_t>(oc.cache_mb) << 20;
+  size_t used = 0;
+  ViewSource source(
+      [&](int g, std::vector<MaskedElement>& out) {
+        const size_t i = static_cast<size_t>(g);
+        if (cached[i]) {
+          out = cache[i];
+          return;
+        }
+        m.cast(m.candidates[i], out);
+        for (const MaskedElement& e : out) m.observable[static_cast<size_t>(e.element)] = 1;
+        if (used + out.size() * sizeof(MaskedElement) <= budget) {
+          used += out.size() * sizeof(MaskedElement);
+          cache[i] = out;
+          cached[i] = 1;
+        }
+      },
+      static_cast<int>(m.candidates.size()), m.bins);
   const CoverResult cover = greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction);
   summary_.observable = cover.observable;
+  fprintf(stderr, "TIMING cover %zu picks %lld evals %.1f ms cache %zu MB\n", cover.picks.size(), (long long)cover.evaluations, watch.ms(), used >> 20);
   summary_.covered = cover.covered;
   summary_.viewpoints = static_cast<int64_t>(cover.picks.size());
   summary_.cover_dropped = cover.dropped;
-  m.observable.assign(m.targets.size(), 0);
-  {
-    // The observable set again (greedy_cover counts it; the coverage report needs its members).
-    std::vector<MaskedElement> els;
-    for (size_t g = 0; g < m.candidates.size(); ++g) {
-      m.cast(m.candidates[g], els);
-      for (const MaskedElement& e : els) m.observable[static_cast<size_t>(e.element)] = 1;
-    }
-  }
-
   // 4. The tour: node 0 the vehicle, then the picks. Path lengths from one search per distinct
   // viewpoint cell (a viewpoint picked at several yaws is one place).
   const size_t k = cover.picks.size();
@@ -559,7 +604,12 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       cost[i][j] = i == j ? 0.0 : travel_time(l, yaw[i], yaw[j], config_.cost);
     }
   for (size_t i = 1; i <= k; ++i) cost[i][0] = cost[0][i];  // never used: the tour does not return
+  fprintf(stderr, "TIMING lengths %.1f ms\n", watch.ms());
   const Tour t = solve_tour(cost, oc.exact_tour_max);
+  fprintf(stderr, "TIMING tour %.1f ms\n", watch.ms());
+  picks_ = cover.picks;
+  tour_costs_ = cost;
+  tour_order_ = t.order;
   summary_.tour_time = t.cost;
   summary_.tour_exact = t.exact;
   std::vector<MaskedElement> els;
@@ -573,7 +623,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     v.yaw = core::wrap_angle(yaw[i]);
     v.gain = p.gain;
     tour_.push_back(v);
-    m.cast(cell[i], els);
+    source.elements(p.group, els);
     std::vector<int32_t> own;
     for (const MaskedElement& e : els)
       if (e.members >> p.member & 1u) {
@@ -582,6 +632,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       }
     tour_elements_.push_back(std::move(own));
   }
+  cache.clear();
   summary_.ready = true;
   summary_.prepare_ms = watch.ms();
   return true;
@@ -653,6 +704,21 @@ std::vector<map::VoxelKey> OracleStrategy::seen_by(size_t i) const {
   for (int32_t e : tour_elements_[i]) keys.push_back(model_->key_of(model_->targets[static_cast<size_t>(e)]));
   return keys;
 }
+
+std::vector<Eigen::Vector3d> OracleStrategy::candidates() const {
+  std::vector<Eigen::Vector3d> out;
+  if (model_)
+    for (int64_t c : model_->candidates) out.push_back(model_->centre(c));
+  return out;
+}
+
+std::vector<MaskedElement> OracleStrategy::candidate_view(size_t candidate) const {
+  std::vector<MaskedElement> out;
+  if (model_ && candidate < model_->candidates.size()) model_->cast(model_->candidates[candidate], out);
+  return out;
+}
+
+int64_t OracleStrategy::target_ids() const { return model_ ? static_cast<int64_t>(model_->targets.size()) : 0; }
 
 PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
   PlanOutcome o;

@@ -163,6 +163,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("clearance_penalty", c.oracle.clearance_penalty, 0.0, 1e6);
   o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
+  o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);
 }
 
 }  // namespace semx::planner

@@ -24,11 +24,13 @@
 
 #include "semx/core/random.hpp"
 #include "semx/fixtures/exploration_sim.hpp"
+#include "semx/fixtures/synthetic_truth.hpp"
 #include "semx/fixtures/synthetic_world.hpp"
 #include "semx/planner/charge_model.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/exploration_planner.hpp"
 #include "semx/planner/gain_evaluator.hpp"
+#include "semx/planner/oracle_strategy.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
 
@@ -157,7 +159,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
-        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep", &planner_name)
+        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep, oracle (reads the world's truth)",
+                &planner_name)
         .option("samples", "N", "sampling density (default: config, 45)", &samples)
         .option("seed", "N", "first seed (runs use seed, seed+1, ...)", &seed)
         .option("runs", "N", "explorations (default 1)", &runs)
@@ -218,6 +221,9 @@ int main(int argc, char** argv) {
         planner.add_unobservable(keys);
         if (run == 0) std::printf("oracle_interior_voxels: %zu\n", keys.size());
       }
+      // The known-map oracle reads the world's truth (its T: what the evaluator would count).
+      const SyntheticTruth truth(*world);
+      planner.set_truth(&truth);
       ExplorationSim sim(*world, planner, o);
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
         if (verbose && out.status && out.status->iteration > 0) {
@@ -231,6 +237,14 @@ int main(int argc, char** argv) {
         }
       });
       if (kernels && run == 0) time_kernels(sim.known(), c);
+      if (const auto* os = dynamic_cast<const OracleStrategy*>(&planner.strategy())) {
+        const auto [t_share, obs_share] = os->coverage(sim.known());
+        std::printf("oracle: %s\n", os->summary().describe().c_str());
+        std::printf("oracle_viewpoints_flown: %zu of %zu (%lld skipped)\n", os->next_viewpoint(), os->tour().size(),
+                    static_cast<long long>(os->skipped()));
+        std::printf("oracle_coverage_of_observable: %.2f %%\n", 100.0 * obs_share);
+        std::printf("oracle_coverage_of_T: %.2f %%\n", 100.0 * t_share);
+      }
       for (size_t i = 0; i < r.cycle_ms.size(); ++i) {
         const CycleCounters& k = r.counters[i];
         cycle_ms.push_back(r.cycle_ms[i]);

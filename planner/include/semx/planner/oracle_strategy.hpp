@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/planner/set_cover.hpp"
 #include "semx/planner/strategy.hpp"
 #include "semx/planner/truth_map.hpp"
 
@@ -94,6 +95,16 @@ class OracleStrategy : public Strategy {
   // The T voxels (keys) viewpoint i of the tour sees at its yaw, by the oracle's camera model.
   std::vector<map::VoxelKey> seen_by(size_t i) const;
 
+  // The problems it solved, for the tests' brute force: the candidates, what each sees (element
+  // = T id, members = yaw bins), the cover's picks; the tour's cost matrix (node 0 the start, node
+  // i the cover's pick i - 1) and the order flown.
+  std::vector<Eigen::Vector3d> candidates() const;
+  std::vector<MaskedElement> candidate_view(size_t candidate) const;
+  int64_t target_ids() const;
+  const std::vector<CoverPick>& picks() const { return picks_; }
+  const std::vector<std::vector<double>>& tour_costs() const { return tour_costs_; }
+  const std::vector<int>& tour_order() const { return tour_order_; }
+
  private:
   struct Model;
   PlannerConfig config_;
@@ -103,6 +114,9 @@ class OracleStrategy : public Strategy {
   std::vector<OracleViewpoint> tour_;
   std::vector<std::vector<int32_t>> tour_elements_;  // T ids each tour viewpoint sees
   std::vector<uint16_t> holders_;                    // tour viewpoints not yet flown that see each T id
+  std::vector<CoverPick> picks_;
+  std::vector<std::vector<double>> tour_costs_;
+  std::vector<int> tour_order_;
   size_t next_ = 0;
   int attempts_ = 0;  // plans toward tour_[next_]
   int64_t skipped_ = 0;

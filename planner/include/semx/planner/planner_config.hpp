@@ -231,6 +231,10 @@ struct OracleConfig {
   double clearance_penalty = 4.0;
   int exact_tour_max = 12;  // tours of at most this many viewpoints are solved exactly (DP)
   int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
+  // MB kept of what the candidates see (8 bytes per voxel and candidate, ~0.4 MB a candidate in a
+  // furnished room): the set cover asks for a candidate's view again whenever one of its bounds
+  // comes first, and beyond this a view is cast again each time (slower, the same result).
+  int cache_mb = 1024;
 };
 
 struct PlannerConfig {
