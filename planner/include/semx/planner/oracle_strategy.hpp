@@ -17,8 +17,10 @@
 //      travel_time() (cost.*) of its path length on the true free space and its turn; paths are
 //      searched on the voxels whose true clearance the checker accepts (door_clearance, bare body
 //      box), charged for flying closer than oracle.preferred_clearance.
-// Then it flies the tour, one viewpoint a goal, as any planner does: a path (the search's, pulled
-// straight where the clearance allows) with yaws turning to the viewpoint's. Legs cross space the
+// Then it flies the tour as any planner flies its goals: a path (the search's, pulled straight
+// where the clearance allows) with yaws turning to the viewpoint's, on through the following
+// viewpoints (up to oracle.chain) while the heading keeps up, so the vehicle stops only where it
+// must turn longer than it flies, and the last viewpoint of the path is the goal. Legs cross space the
 // live map does not know yet; it trusts the truth there (trusts_own_paths), the controller checks
 // its own ESDF. A viewpoint none of whose T voxels is still unknown in the live map unless it is
 // the last one of the tour left to see it, is skipped. DONE after the last viewpoint.
@@ -51,6 +53,7 @@ struct OracleSummary {
   int64_t covered = 0;      // ... that the picked viewpoints see
   int64_t viewpoints = 0;   // picked
   int64_t cover_dropped = 0;
+  int64_t first_pass = 0;   // viewpoints of the first tour (oracle.first_pass), the rest in the second
   double tour_time = 0.0;    // s, the tour's summed leg costs
   double tour_length = 0.0;  // m
   bool tour_exact = false;
@@ -118,7 +121,8 @@ class OracleStrategy : public Strategy {
   std::vector<std::vector<double>> tour_costs_;
   std::vector<int> tour_order_;
   size_t next_ = 0;
-  int attempts_ = 0;  // plans toward tour_[next_]
+  size_t chain_end_ = 0;  // the last viewpoint of the path being flown (its goal)
+  int attempts_ = 0;      // plans toward tour_[next_]
   int64_t skipped_ = 0;
   bool prepared_ = false;
 };

@@ -230,7 +230,15 @@ struct OracleConfig {
   double preferred_clearance = 0.6;
   double clearance_penalty = 4.0;
   int exact_tour_max = 12;  // tours of at most this many viewpoints are solved exactly (DP)
+  // The tour's first pass: from the start, the pick that shows the most new T voxels per second
+  // of travel, again and again, until this share of the observable part is shown; then one tour
+  // through the rest (0: a single tour through every pick, the fastest to the last voxel).
+  double first_pass = 0.9;
   int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
+  // Viewpoints one path flies through at most: on past a viewpoint while the turn into it takes
+  // no longer than the flight (the heading keeps up), so the vehicle does not stop at each; 1:
+  // one goal per viewpoint, the vehicle stopping and dwelling at every one.
+  int chain = 8;
   // MB kept of what the candidates see (8 bytes per voxel and candidate, ~0.4 MB a candidate in a
   // furnished room): the set cover asks for a candidate's view again whenever one of its bounds
   // comes first, and beyond this a view is cast again each time (slower, the same result).
