@@ -70,6 +70,9 @@ struct OracleStrategy::Model {
   std::vector<uint32_t> allowed;   // bit k: moves()[k] from this cell keeps to passable cells
   std::vector<int64_t> move_offset;
   std::vector<double> move_length;  // m
+  std::vector<float> move_cost;     // half the length: a move costs it times the two cells' factors
+  mutable std::vector<float> search_cost;  // scratch of search()
+  mutable std::vector<uint8_t> search_want;
   map::StateGrid grid;              // the truth as a map (outside the box unknown: an obstacle)
   CollisionChecker checker;
   double cap = 0.6;  // clearances are exact up to this
@@ -176,6 +179,7 @@ OracleStrategy::Model::Model(const TruthMap& truth, const PlannerConfig& config)
   for (const Move& m : moves()) {
     move_offset.push_back(m.dx + m.dy * sy + m.dz * sz);
     move_length.push_back(m.length * res);
+    move_cost.push_back(static_cast<float>(0.5 * m.length * res));
   }
   // A move is allowed when every cell of its bounding box is passable: a diagonal step cannot cut
   // the corner of a cell a path may not pass through.
@@ -332,12 +336,12 @@ void OracleStrategy::Model::cast(int64_t o, std::vector<MaskedElement>& out) {
 
 void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<float>& length,
                                    std::vector<int32_t>* parent, const std::vector<int64_t>* wanted) const {
-  std::vector<float> cost(n, kUnreached);
+  std::vector<float>& cost = search_cost;
+  cost.assign(n, kUnreached);
   length.assign(n, kUnreached);
   if (parent) parent->assign(n, -1);
-  std::vector<uint8_t> done(n, 0);
   size_t left = 0;
-  std::vector<uint8_t> want;
+  std::vector<uint8_t>& want = search_want;
   if (wanted) {
     want.assign(n, 0);
     for (int64_t w : *wanted)
@@ -346,33 +350,37 @@ void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<f
   const Eigen::Vector3d goal = target >= 0 ? centre(target) : Eigen::Vector3d::Zero();
   // A*'s heuristic: the straight distance, a lower bound (every factor is at least 1).
   auto h = [&](int64_t i) { return target >= 0 ? static_cast<float>((centre(i) - goal).norm()) : 0.0f; };
-  using Entry = std::pair<float, int64_t>;
+  // Entries (cost + heuristic, cell); one whose cost is no longer the cell's is stale.
+  using Entry = std::pair<float, int32_t>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
   cost[static_cast<size_t>(source)] = 0.0f;
   length[static_cast<size_t>(source)] = 0.0f;
-  open.emplace(h(source), source);
+  open.emplace(h(source), static_cast<int32_t>(source));
   while (!open.empty()) {
-    const auto [key, i] = open.top();
+    const auto [key, i32] = open.top();
     open.pop();
+    const int64_t i = i32;
     const size_t u = static_cast<size_t>(i);
-    if (done[u]) continue;
-    done[u] = 1;
+    if (key > cost[u] + h(i) + 1e-4f) continue;  // stale
     if (i == target) return;
-    if (wanted && want[u] && --left == 0) return;
+    if (wanted && want[u]) {
+      want[u] = 0;
+      if (--left == 0) return;
+    }
     // The source may lie off the graph (a vehicle that braked near a wall): it leaves by any move
     // into a passable cell.
     const uint32_t bits = (flags[u] & kPassable) ? allowed[u] : ~0u;
-    for (size_t k = 0; k < move_offset.size(); ++k) {
-      if (!(bits >> k & 1u)) continue;
-      const int64_t j = i + move_offset[k];
-      const size_t v = static_cast<size_t>(j);
-      if (done[v] || !(flags[v] & kPassable)) continue;
-      const float c = cost[u] + static_cast<float>(move_length[k] * 0.5 * (factor[u] + factor[v]));
+    const float fu = factor[u], cu = cost[u], lu = length[u];
+    for (uint32_t b = bits & ((1u << move_offset.size()) - 1); b; b &= b - 1) {
+      const size_t k = static_cast<size_t>(__builtin_ctz(b));
+      const size_t v = static_cast<size_t>(i + move_offset[k]);
+      if (!(flags[v] & kPassable)) continue;
+      const float c = cu + move_cost[k] * (fu + factor[v]);
       if (c < cost[v]) {
         cost[v] = c;
-        length[v] = length[u] + static_cast<float>(move_length[k]);
-        if (parent) (*parent)[v] = static_cast<int32_t>(i);
-        open.emplace(c + h(j), j);
+        length[v] = lu + static_cast<float>(move_length[k]);
+        if (parent) (*parent)[v] = i32;
+        open.emplace(c + h(static_cast<int64_t>(v)), static_cast<int32_t>(v));
       }
     }
   }
@@ -418,8 +426,9 @@ std::string OracleSummary::describe() const {
     return s.str();
   }
   s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
-    << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints see "
-    << 100.0 * cover_share() << " % of that (" << cover_dropped << " redundant dropped); tour "
+    << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
+    << first_pass << " in the first pass) see " << 100.0 * cover_share() << " % of that (" << cover_dropped
+    << " redundant dropped); tour "
     << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
     << "; prepared in " << prepare_ms / 1000.0 << " s";
   return s.str();
@@ -538,12 +547,14 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     return false;
   }
 
-  // 2-3. What each sees, and the cover.
-  // The cover asks for a candidate's view again whenever one of its bounds comes first: kept, up
-  // to oracle.cache_mb, a view is cast once (the same lists either way).
+  // 2. What each candidate sees, at every yaw bin. The first pass and the cover ask for a
+  // candidate's view again and again: kept, up to oracle.cache_mb, a view is cast once (the same
+  // lists either way).
+  const int bins = m.bins;
+  const size_t groups = m.candidates.size();
   m.observable.assign(m.targets.size(), 0);
-  std::vector<std::vector<MaskedElement>> cache(m.candidates.size());
-  std::vector<uint8_t> cached(m.candidates.size(), 0);
+  std::vector<std::vector<MaskedElement>> cache(groups);
+  std::vector<uint8_t> cached(groups, 0);
   const size_t budget = static_cast<size_t>(oc.cache_mb) << 20;
   size_t used = 0;
   ViewSource source(
@@ -554,49 +565,125 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           return;
         }
         m.cast(m.candidates[i], out);
-        for (const MaskedElement& e : out) m.observable[static_cast<size_t>(e.element)] = 1;
         if (used + out.size() * sizeof(MaskedElement) <= budget) {
           used += out.size() * sizeof(MaskedElement);
           cache[i] = out;
           cached[i] = 1;
         }
       },
-      static_cast<int>(m.candidates.size()), m.bins);
-  const CoverResult cover = greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction);
+      static_cast<int>(groups), bins);
+  std::vector<MaskedElement> els;
+  std::vector<int64_t> bound(groups * static_cast<size_t>(bins), 0);  // T voxels (g, b) shows, at most
+  int64_t observable = 0;
+  for (size_t g = 0; g < groups; ++g) {
+    source.elements(static_cast<int>(g), els);
+    for (const MaskedElement& e : els) {
+      if (!m.observable[static_cast<size_t>(e.element)]) m.observable[static_cast<size_t>(e.element)] = 1, ++observable;
+      for (uint32_t x = e.members; x; x &= x - 1) ++bound[g * static_cast<size_t>(bins) + static_cast<size_t>(__builtin_ctz(x))];
+    }
+  }
+  auto yaw_of = [&](int b) { return b * 2.0 * M_PI / bins; };
+
+  // 3. The first pass: from the vehicle, the view (candidate, yaw) that shows the most T voxels
+  // not yet shown per second of travel (travel_time() of the path length on the true free space
+  // and the turn), again and again, until oracle.first_pass of the observable part is shown. What
+  // a view shows only shrinks as more is shown, so a ratio computed earlier is an upper bound:
+  // only the views whose bound comes first are counted again (from the cache).
+  std::vector<uint8_t> shown(m.targets.size(), 0);
+  std::vector<std::pair<int, int>> walk;  // (candidate, bin)
+  {
+    int64_t have = 0;
+    const auto want = static_cast<int64_t>(std::ceil(oc.first_pass * static_cast<double>(observable)));
+    int64_t cur = s;
+    double cur_yaw = start_yaw;
+    std::vector<float> len;
+    std::vector<int64_t> gains(static_cast<size_t>(bins));
+    std::vector<int> counted(groups, -1);  // the step at which a candidate was last counted
+    for (int step = 0; have < want; ++step) {
+      m.search(cur, -1, len, nullptr);
+      auto time_to = [&](size_t g, int b) {
+        const float l = len[static_cast<size_t>(m.candidates[g])];
+        return l < kUnreached ? travel_time(l, cur_yaw, yaw_of(b), config_.cost) : -1.0;
+      };
+      using Entry = std::tuple<double, int, int, bool>;  // ratio (bound), candidate, bin, exact
+      std::priority_queue<Entry> heap;
+      for (size_t g = 0; g < groups; ++g)
+        for (int b = 0; b < bins; ++b) {
+          const int64_t gb = bound[g * static_cast<size_t>(bins) + static_cast<size_t>(b)];
+          const double t = gb > 0 ? time_to(g, b) : -1.0;
+          if (t > 0) heap.emplace(static_cast<double>(gb) / t, static_cast<int>(g), b, false);
+        }
+      int pick_g = -1, pick_b = -1;
+      while (!heap.empty()) {
+        const auto [ratio, g, b, exact] = heap.top();
+        heap.pop();
+        if (exact) {
+          pick_g = g;
+          pick_b = b;
+          break;
+        }
+        if (counted[static_cast<size_t>(g)] == step) continue;  // its exact entries are in the heap
+        counted[static_cast<size_t>(g)] = step;
+        source.elements(g, els);
+        std::fill(gains.begin(), gains.end(), 0);
+        for (const MaskedElement& e : els)
+          if (!shown[static_cast<size_t>(e.element)])
+            for (uint32_t x = e.members; x; x &= x - 1) ++gains[static_cast<size_t>(__builtin_ctz(x))];
+        for (int k = 0; k < bins; ++k) {
+          bound[static_cast<size_t>(g) * static_cast<size_t>(bins) + static_cast<size_t>(k)] = gains[static_cast<size_t>(k)];
+          const double t = gains[static_cast<size_t>(k)] > 0 ? time_to(static_cast<size_t>(g), k) : -1.0;
+          if (t > 0) heap.emplace(static_cast<double>(gains[static_cast<size_t>(k)]) / t, g, k, true);
+        }
+        (void)ratio;
+      }
+      if (pick_g < 0) break;
+      source.elements(pick_g, els);
+      for (const MaskedElement& e : els)
+        if ((e.members >> pick_b & 1u) && !shown[static_cast<size_t>(e.element)])
+          shown[static_cast<size_t>(e.element)] = 1, ++have;
+      walk.emplace_back(pick_g, pick_b);
+      summary_.tour_length += len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
+      summary_.tour_time += time_to(static_cast<size_t>(pick_g), pick_b);
+      cur = m.candidates[static_cast<size_t>(pick_g)];
+      cur_yaw = yaw_of(pick_b);
+    }
+  }
+
+  // 4. The cover of the rest: greedy picks until cover_fraction of the observable part is shown,
+  // what the first pass showed counting.
+  const CoverResult cover = greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction, &shown);
   summary_.observable = cover.observable;
-  fprintf(stderr, "TIMING cover %zu picks %lld evals %.1f ms cache %zu MB\n", cover.picks.size(), (long long)cover.evaluations, watch.ms(), used >> 20);
   summary_.covered = cover.covered;
-  summary_.viewpoints = static_cast<int64_t>(cover.picks.size());
+  summary_.first_pass = static_cast<int64_t>(walk.size());
+  summary_.viewpoints = static_cast<int64_t>(walk.size() + cover.picks.size());
   summary_.cover_dropped = cover.dropped;
-  // 4. The tour: node 0 the vehicle, then the picks. Path lengths from one search per distinct
-  // viewpoint cell (a viewpoint picked at several yaws is one place).
+  fprintf(stderr, "TIMING cover walk %zu picks %zu evals %lld %.1f ms cache %zu MB\n", walk.size(), cover.picks.size(), (long long)cover.evaluations, watch.ms(), used >> 20);
+
+  // 5. The tour of the picks, from where the first pass ended: node 0 that place, node i pick
+  // i - 1. Path lengths from one search per distinct cell (a place picked at several yaws is one).
   const size_t k = cover.picks.size();
   std::vector<int64_t> cell(k + 1);
   std::vector<double> yaw(k + 1);
-  cell[0] = s;
-  yaw[0] = start_yaw;
+  cell[0] = walk.empty() ? s : m.candidates[static_cast<size_t>(walk.back().first)];
+  yaw[0] = walk.empty() ? start_yaw : yaw_of(walk.back().second);
   for (size_t i = 0; i < k; ++i) {
     cell[i + 1] = m.candidates[static_cast<size_t>(cover.picks[i].group)];
-    yaw[i + 1] = cover.picks[i].member * 2.0 * M_PI / m.bins;
+    yaw[i + 1] = yaw_of(cover.picks[i].member);
   }
   std::vector<std::vector<double>> length(k + 1, std::vector<double>(k + 1, 0.0));
   {
     std::vector<int64_t> wanted(cell.begin() + 1, cell.end());
     std::vector<float> len;
     for (size_t i = 0; i <= k; ++i) {
-      if (i == 0) {
-        len = m.start_length;
-      } else {
-        bool same = false;
-        for (size_t j = 1; j < i && !same; ++j) {
-          if (cell[j] == cell[i]) {
-            length[i] = length[j];
-            same = true;
-          }
+      bool same = false;
+      for (size_t j = 0; j < i && !same; ++j) {
+        if (cell[j] == cell[i]) {
+          length[i] = length[j];
+          same = true;
         }
-        if (same) continue;
-        m.search(cell[i], -1, len, nullptr, &wanted);
       }
+      if (same) continue;
+      m.search(cell[i], -1, len, nullptr, &wanted);
       for (size_t j = 1; j <= k; ++j) length[i][j] = len[static_cast<size_t>(cell[j])];
     }
   }
@@ -607,78 +694,45 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       cost[i][j] = i == j ? 0.0 : travel_time(l, yaw[i], yaw[j], config_.cost);
     }
   for (size_t i = 1; i <= k; ++i) cost[i][0] = cost[0][i];  // never used: the tour does not return
-  fprintf(stderr, "TIMING lengths %.1f ms\n", watch.ms());
-  // The order. A first pass from the start takes, one at a time, the pick that shows the most T
-  // voxels not yet shown per second of travel from the last one, until oracle.first_pass of the
-  // observable part is shown; the rest is an open tour (tour_solver.hpp) from where it ended.
-  // One tour through every pick minimises the time to the last voxel but sweeps the map at the
-  // pace of its corners: in the planners' closed loop (semx-perf-planner --world env1) it reached
-  // 95 % of T at 22 s, DEP at 15 s, the first pass at 12 s (the end 4 s later than one tour).
-  std::vector<MaskedElement> els;
-  std::vector<std::vector<int32_t>> own(k + 1);  // T ids each pick shows (node i: pick i - 1)
-  for (size_t i = 1; i <= k; ++i) {
-    source.elements(cover.picks[i - 1].group, els);
-    for (const MaskedElement& e : els)
-      if (e.members >> cover.picks[i - 1].member & 1u) own[i].push_back(e.element);
-  }
-  Tour t;
-  t.exact = true;
-  t.order = {0};
-  std::vector<bool> toured(k + 1, false);
-  {
-    std::vector<uint8_t> shown(m.targets.size(), 0);
-    int64_t have = 0;
-    const auto want = static_cast<int64_t>(std::ceil(oc.first_pass * static_cast<double>(cover.observable)));
-    while (have < want) {
-      int best = -1;
-      double best_rate = 0.0;
-      for (size_t i = 1; i <= k; ++i) {
-        if (toured[i]) continue;
-        int64_t g = 0;
-        for (int32_t e : own[i]) g += !shown[static_cast<size_t>(e)];
-        const double rate = static_cast<double>(g) / cost[static_cast<size_t>(t.order.back())][i];
-        if (g > 0 && rate > best_rate) best_rate = rate, best = static_cast<int>(i);
-      }
-      if (best < 0) break;
-      toured[static_cast<size_t>(best)] = true;
-      for (int32_t e : own[static_cast<size_t>(best)])
-        if (!shown[static_cast<size_t>(e)]) shown[static_cast<size_t>(e)] = 1, ++have;
-      t.order.push_back(best);
-    }
-  }
-  const size_t split = t.order.size() - 1;
-  {
-    std::vector<int> nodes{t.order.back()};
-    for (size_t i = 1; i <= k; ++i)
-      if (!toured[i]) nodes.push_back(static_cast<int>(i));
-    std::vector<std::vector<double>> c(nodes.size(), std::vector<double>(nodes.size(), 0.0));
-    for (size_t x = 0; x < nodes.size(); ++x)
-      for (size_t y = 1; y < nodes.size(); ++y)
-        c[x][y] = cost[static_cast<size_t>(nodes[x])][static_cast<size_t>(nodes[y])];
-    const Tour rest = solve_tour(c, oc.exact_tour_max);
-    t.exact = rest.exact;
-    for (size_t q = 1; q < rest.order.size(); ++q) t.order.push_back(nodes[static_cast<size_t>(rest.order[q])]);
-  }
-  t.cost = tour_cost(cost, t.order);
-  fprintf(stderr, "TIMING tour %.1f ms split %zu of %zu\n", watch.ms(), split, k);
-  summary_.first_pass = static_cast<int64_t>(split);
+  const Tour t = solve_tour(cost, oc.exact_tour_max);
+  fprintf(stderr, "TIMING tour %.1f ms\n", watch.ms());
   picks_ = cover.picks;
   tour_costs_ = cost;
   tour_order_ = t.order;
-  summary_.tour_time = t.cost;
   summary_.tour_exact = t.exact;
+
+  // The viewpoints in the order flown: the first pass's, then the tour's.
   holders_.assign(m.targets.size(), 0);
+  auto add = [&](int g, int b, int64_t gain) {
+    OracleViewpoint v;
+    v.position = m.centre(m.candidates[static_cast<size_t>(g)]);
+    v.yaw = core::wrap_angle(yaw_of(b));
+    v.gain = gain;
+    tour_.push_back(v);
+    source.elements(g, els);
+    std::vector<int32_t> own;
+    for (const MaskedElement& e : els)
+      if (e.members >> b & 1u) {
+        own.push_back(e.element);
+        if (holders_[static_cast<size_t>(e.element)] < UINT16_MAX) ++holders_[static_cast<size_t>(e.element)];
+      }
+    tour_elements_.push_back(std::move(own));
+  };
+  {
+    std::vector<uint8_t> seen(m.targets.size(), 0);
+    for (const auto& [g, b] : walk) {
+      source.elements(g, els);
+      int64_t gain = 0;
+      for (const MaskedElement& e : els)
+        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++gain;
+      add(g, b, gain);
+    }
+  }
+  summary_.tour_time += t.cost;
   for (size_t q = 1; q < t.order.size(); ++q) {
     const size_t i = static_cast<size_t>(t.order[q]);
     summary_.tour_length += length[static_cast<size_t>(t.order[q - 1])][i];
-    OracleViewpoint v;
-    v.position = m.centre(cell[i]);
-    v.yaw = core::wrap_angle(yaw[i]);
-    v.gain = cover.picks[i - 1].gain;
-    tour_.push_back(v);
-    for (int32_t e : own[i])
-      if (holders_[static_cast<size_t>(e)] < UINT16_MAX) ++holders_[static_cast<size_t>(e)];
-    tour_elements_.push_back(std::move(own[i]));
+    add(cover.picks[i - 1].group, cover.picks[i - 1].member, cover.picks[i - 1].gain);
   }
   cache.clear();
   summary_.ready = true;

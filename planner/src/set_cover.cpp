@@ -9,11 +9,15 @@
 
 namespace semx::planner {
 
-CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fraction) {
+CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fraction,
+                         const std::vector<uint8_t>* already) {
   CoverResult r;
   const int groups = source.groups(), members = source.members();
   if (members < 1 || members > 32) throw std::invalid_argument("greedy_cover: 1-32 members per group");
-  std::vector<uint8_t> covered(static_cast<size_t>(num_elements), 0), observable(covered.size(), 0);
+  if (already && already->size() != static_cast<size_t>(num_elements))
+    throw std::invalid_argument("greedy_cover: one covered flag per element");
+  std::vector<uint8_t> covered = already ? *already : std::vector<uint8_t>(static_cast<size_t>(num_elements), 0);
+  std::vector<uint8_t> observable(covered.size(), 0);
   // bound[g * members + m]: the gain of set (g, m) when last evaluated, an upper bound of it now.
   std::vector<int64_t> bound(static_cast<size_t>(groups) * members, 0);
   std::vector<int64_t> fresh(static_cast<size_t>(groups), -1);  // round of the group's last evaluation
@@ -38,6 +42,7 @@ CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fract
       if (e.members && !observable[static_cast<size_t>(e.element)]) {
         observable[static_cast<size_t>(e.element)] = 1;
         ++r.observable;
+        r.covered += covered[static_cast<size_t>(e.element)];
       }
     }
     fresh[static_cast<size_t>(g)] = 0;
@@ -83,7 +88,11 @@ CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fract
   }
   // Redundant picks: how many picks hold each element; a pick whose elements are all held by
   // others too, or whose own ones the required share can spare, goes.
+  // Elements covered before the first pick are held by something no pick is: never lost.
   std::vector<uint16_t> holders(covered.size(), 0);
+  if (already)
+    for (size_t e = 0; e < covered.size(); ++e)
+      if ((*already)[e]) holders[e] = 1;
   std::vector<std::vector<int32_t>> own(r.picks.size());
   for (size_t i = 0; i < r.picks.size(); ++i) {
     source.elements(r.picks[i].group, els);

@@ -47,7 +47,10 @@ struct CoverResult {
   int64_t dropped = 0;           // picks found redundant afterwards
 };
 
-CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fraction);
+// `covered` (optional, num_elements flags): elements already covered before the first pick (the
+// oracle's first pass saw them); they count toward the share and no pick is chosen for them.
+CoverResult greedy_cover(CoverSource& source, int32_t num_elements, double fraction,
+                         const std::vector<uint8_t>* covered = nullptr);
 
 // A CoverSource over sets given in full (tests, small problems): sets[g][m] lists group g's
 // member m's elements.
