@@ -1,9 +1,11 @@
 #include "planner_node.hpp"
 
 #include <algorithm>
+#include <iostream>
 #include <string>
 
 #include "planner_messages.hpp"
+#include "semx/planner/oracle_strategy.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::planner {
@@ -43,6 +45,11 @@ PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& conf
                   std::string(to_string(planner_.kind())) + ": waiting for the map");
 }
 
+void PlannerNode::set_truth(std::shared_ptr<const TruthMap> truth) {
+  truth_ = std::move(truth);
+  planner_.set_truth(truth_.get());
+}
+
 void PlannerNode::on_tick(int64_t /*tick*/, int64_t utime) {
   if (last_utime_ >= 0 && utime < last_utime_) {
     // The clock restarted (a new episode): nothing from the old one applies.
@@ -80,6 +87,13 @@ void PlannerNode::on_tick(int64_t /*tick*/, int64_t utime) {
 
 void PlannerNode::update_node_state() {
   reported_state_ = planner_.state();
+  // The oracle's plan, once made: what it promises to see, for the run's log (logs/planner.log).
+  if (const auto* o = dynamic_cast<const OracleStrategy*>(&planner_.strategy()); o && !oracle_reported_) {
+    if (o->summary().ready || !o->summary().error.empty()) {
+      std::cout << "semx-planner: " << o->summary().describe() << std::endl;
+      oracle_reported_ = true;
+    }
+  }
   const StatusReport& s = planner_.last_status();
   std::string detail = std::string(to_string(planner_.kind())) + " " + to_string(planner_.state()) + " it " +
                        std::to_string(planner_.iteration()) + ", plan " + std::to_string(planner_.plan_id()) +

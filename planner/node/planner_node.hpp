@@ -14,6 +14,7 @@
 #include "map_client.hpp"
 #include "semx/planner/exploration_planner.hpp"
 #include "semx/planner/planner_config.hpp"
+#include "semx/planner/truth_map.hpp"
 #include "semx/runtime/node.hpp"
 
 namespace semx::planner {
@@ -26,6 +27,8 @@ class PlannerNode {
   ExplorationPlanner& planner() { return planner_; }
   const map::MapClient& map() const { return *map_; }
   int run() { return node_.run(); }
+  // The world's ground truth for the known-map oracle (--world); the other planners ignore it.
+  void set_truth(std::shared_ptr<const TruthMap> truth);
 
   // One tick of simulation time (what SIM_CLOCK triggers); public for tests.
   void on_tick(int64_t tick, int64_t utime);
@@ -39,11 +42,13 @@ class PlannerNode {
   PlannerConfig config_;
   runtime::Node node_;
   std::unique_ptr<map::MapClient> map_;
+  std::shared_ptr<const TruthMap> truth_;
   ExplorationPlanner planner_;
   int64_t last_utime_ = -1;
   int64_t last_status_utime_ = -1;
   int64_t deferred_cycle_utime_ = -1;  // a cycle due at this tick runs after its ack
   PlannerState reported_state_ = PlannerState::kInit;
+  bool oracle_reported_ = false;  // the oracle's plan was written to the log
 };
 
 }  // namespace semx::planner

@@ -172,6 +172,9 @@ double ExplorationPlanner::min_gain_now() const {
 
 bool ExplorationPlanner::path_blocked() const {
   if (!goal_.valid || !pose_ || goal_.waypoints.size() < 2) return false;
+  // The oracle's legs cross space the live map does not know yet, which every check below calls
+  // blocked; it planned them on the true map, which does not change.
+  if (strategy_->trusts_own_paths()) return false;
   const std::vector<Eigen::Vector3d>& w = goal_.waypoints;
   // The segment the vehicle is on: the nearest one to it.
   size_t seg = 0;
@@ -362,7 +365,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     const int limit = o.unreachable_informative > 0
                           ? std::max(config_.loop.done_cycles, config_.loop.max_recovery_cycles)
                           : config_.loop.done_cycles;
-    next = no_goal_cycles_ >= limit ? PlannerState::kDone : PlannerState::kRecovering;
+    next = no_goal_cycles_ >= limit || o.finished ? PlannerState::kDone : PlannerState::kRecovering;
     reason = next == PlannerState::kDone ? o.reason : why + ": " + o.reason;
   } else {
     next = PlannerState::kExecuting;

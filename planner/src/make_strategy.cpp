@@ -2,6 +2,7 @@
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/nbv_strategy.hpp"
+#include "semx/planner/oracle_strategy.hpp"
 #include "semx/planner/strategy.hpp"
 
 namespace semx::planner {
@@ -18,6 +19,8 @@ std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
       return std::make_unique<AepStrategy>(config);
     case PlannerKind::kFuel:
       return std::make_unique<FuelStrategy>(config);
+    case PlannerKind::kOracle:
+      return std::make_unique<OracleStrategy>(config);
   }
   return nullptr;
 }

@@ -18,6 +18,8 @@ const char* to_string(PlannerKind k) {
       return "aep";
     case PlannerKind::kFuel:
       return "fuel";
+    case PlannerKind::kOracle:
+      return "oracle";
   }
   return "?";
 }
@@ -28,7 +30,8 @@ PlannerKind parse_planner_kind(const std::string& name) {
   if (name == "nbv") return PlannerKind::kNbv;
   if (name == "aep") return PlannerKind::kAep;
   if (name == "fuel") return PlannerKind::kFuel;
-  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep, fuel)");
+  if (name == "oracle") return PlannerKind::kOracle;
+  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep, fuel, oracle)");
 }
 
 double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
@@ -50,7 +53,7 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel"});
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 
@@ -183,6 +186,20 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("search_step", fu.search_step, 1, 8);
   f.get("low_clearance_penalty", fu.low_clearance_penalty, 0.0, 100.0);
   f.get("cost_budget", fu.cost_budget, 1000, 100000000);
+
+  auto o = m.child("oracle");
+  o.get("spacing", c.oracle.spacing, 0.05, 10.0);
+  o.get("height_step", c.oracle.height_step, 0.05, 10.0);
+  o.get("rays_azimuth", c.oracle.rays_azimuth, 8, 4096);
+  o.get("rays_elevation", c.oracle.rays_elevation, 1, 1024);
+  o.get("cover_fraction", c.oracle.cover_fraction, 0.0, 1.0);
+  o.get("preferred_clearance", c.oracle.preferred_clearance, 0.0, 5.0);
+  o.get("clearance_penalty", c.oracle.clearance_penalty, 0.0, 1e6);
+  o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
+  o.get("first_pass", c.oracle.first_pass, 0.0, 1.0);
+  o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
+  o.get("chain", c.oracle.chain, 1, 1000);
+  o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);
 }
 
 }  // namespace semx::planner

@@ -142,4 +142,23 @@ Tour solve_open_tour(const TourProblem& p, int exact_max, int first) {
   return heuristic_open_tour(p, first);
 }
 
+
+Tour solve_tour(const std::vector<std::vector<double>>& cost, int exact_max) {
+  TourProblem p;
+  p.n = static_cast<int>(cost.size());
+  p.cost.reserve(static_cast<std::size_t>(p.n) * static_cast<std::size_t>(p.n));
+  for (const auto& row : cost) p.cost.insert(p.cost.end(), row.begin(), row.end());
+  Tour t = p.n > 1 ? solve_open_tour(p, exact_max) : Tour{};
+  if (p.n <= 1) t.exact = true;
+  t.order.insert(t.order.begin(), 0);
+  return t;
+}
+
+double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector<int>& order) {
+  double c = 0.0;
+  for (std::size_t i = 1; i < order.size(); ++i)
+    c += cost[static_cast<std::size_t>(order[i - 1])][static_cast<std::size_t>(order[i])];
+  return c;
+}
+
 }  // namespace semx::planner

@@ -60,6 +60,9 @@ class ExplorationPlanner {
   void on_map_reset();
   void set_pose(const VehiclePose& pose);
   void set_regions(std::vector<SemanticRegion> regions) { regions_ = std::move(regions); }
+  // The world's ground truth, for the known-map oracle only (Strategy::set_truth; the other
+  // planners ignore it). Must outlive the planner's use.
+  void set_truth(const TruthMap* truth) { strategy_->set_truth(truth); }
   void on_controller_status(ControllerState state, int64_t plan_id);
 
   struct Output {

@@ -14,13 +14,17 @@
 
 namespace semx::planner {
 
-// The four planners of the paper's comparison (DESIGN.md §4), and FUEL as a later baseline.
+// The four planners of the paper's comparison (DESIGN.md §4), FUEL as a later baseline, and a
+// reference that cheats.
 enum class PlannerKind {
   kSemanticDep,  // DEP roadmap + semantic reward (the paper's method)
   kDep,          // the same roadmap, semantics off
   kNbv,          // receding-horizon RRT next-best-view (Bircher 2016)
   kAep,          // RRT* with cached gains and frontier fallback (Selin 2019)
   kFuel,         // frontier clusters, a global tour over their viewpoints (Zhou 2021)
+  // NOT an exploration method: reads the world's ground truth and flies a precomputed tour of
+  // viewpoints that sees it (oracle_strategy.hpp), the physical-limit reference of the bench.
+  kOracle,
 };
 const char* to_string(PlannerKind k);
 // Throws std::invalid_argument for an unknown name.
@@ -285,8 +289,45 @@ struct FuelConfig {
   int cost_budget = 120000;
 };
 
+// The known-map oracle (oracle_strategy.hpp; docs/planner.md, "The known-map oracle"). It knows
+// the world (the evaluator's ground truth), so none of this is exploration: viewpoints on a
+// lattice of the true free space, a greedy set cover of the target set T, a tour through them.
+// The body, clearances, heights (sampling.z_min/z_max), camera and range (gain.*), yaw bins
+// (gain.yaw_bins) and travel time (cost.*) are the other planners'.
+struct OracleConfig {
+  double spacing = 0.5;      // m, horizontal pitch of the lattice of candidate viewpoints
+  double height_step = 0.5;  // m, its vertical pitch, from sampling.z_min up
+  // Visibility rays per candidate: around it (360°) and across the camera's vertical field of
+  // view. 384 x 64 are 0.94° x 1.15° apart, a voxel at 5-6 m; the real camera (0.14° a pixel)
+  // sees at least what they see. What the rays miss between them far away the cover must find
+  // elsewhere: with 256 x 48 it picked 34 viewpoints in env1, with 384 x 64 24.
+  int rays_azimuth = 384;
+  int rays_elevation = 64;
+  // The tour must see this share of what all candidates together see of T (the observable part).
+  double cover_fraction = 0.99;
+  // m: legs keep this far from obstacles where there is room (the path search charges
+  // clearance_penalty per metre flown and per metre below it), so they go through the middle of
+  // doorways and rooms, as far as they can from walls the live map may not know yet.
+  double preferred_clearance = 0.6;
+  double clearance_penalty = 4.0;
+  int exact_tour_max = 12;  // tours of at most this many viewpoints are solved exactly (DP)
+  // The tour's first pass: from the start, the pick that shows the most new T voxels per second
+  // of travel, again and again, until this share of the observable part is shown; then one tour
+  // through the rest (0: a single tour through every pick, the fastest to the last voxel).
+  double first_pass = 0.9;
+  int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
+  // Viewpoints one path flies through at most: on past a viewpoint while the turn into it takes
+  // no longer than the flight (the heading keeps up), so the vehicle does not stop at each; 1:
+  // one goal per viewpoint, the vehicle stopping and dwelling at every one.
+  int chain = 8;
+  // MB kept of what the candidates see (8 bytes per voxel and candidate, ~0.4 MB a candidate in a
+  // furnished room): the set cover asks for a candidate's view again whenever one of its bounds
+  // comes first, and beyond this a view is cast again each time (slower, the same result).
+  int cache_mb = 1024;
+};
+
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -300,6 +341,7 @@ struct PlannerConfig {
   NbvConfig nbv;
   AepConfig aep;
   FuelConfig fuel;
+  OracleConfig oracle;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };

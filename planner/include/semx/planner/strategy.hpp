@@ -1,7 +1,8 @@
 // What the main loop (ExplorationPlanner) asks of a planning method: one cycle's best goal and
 // the path to it. DEP (with or without semantics), NBV, AEP and FUEL implement it (dep_strategy.hpp,
 // nbv_strategy.hpp, aep_strategy.hpp, fuel_strategy.hpp) on the same map, sensor model and
-// collision checks.
+// collision checks; the known-map oracle (oracle_strategy.hpp) too, on the world's ground truth
+// instead.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +19,7 @@
 #include "semx/planner/plan_types.hpp"
 #include "semx/planner/planner_config.hpp"
 #include "semx/planner/semantic_reward.hpp"
+#include "semx/planner/truth_map.hpp"
 #include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
@@ -59,6 +61,9 @@ struct PlanOutcome {
   // No goal, but roadmap nodes with gain exist that the vehicle cannot reach (the graph came
   // apart, e.g. edges through a doorway were pruned): worth recovering longer before DONE.
   int64_t unreachable_informative = 0;
+  // Nothing is left to do at all (the oracle flew its last viewpoint): DONE at once, without the
+  // done_cycles of cycles that look for a goal again.
+  bool finished = false;
 };
 
 class Strategy {
@@ -83,6 +88,12 @@ class Strategy {
   virtual bool receding_horizon() const = 0;
   virtual RoadmapView roadmap(const Goal* goal) const = 0;
   virtual void reset() = 0;
+  // The world's ground truth (must outlive the strategy's use). Only the known-map oracle reads
+  // it; every exploration method ignores it, so none can cheat by accident.
+  virtual void set_truth(const TruthMap* /*truth*/) {}
+  // The strategy's paths are safe by its own knowledge, not the live map's: the main loop does not
+  // call them blocked when they cross space the live map does not know yet (the oracle's legs do).
+  virtual bool trusts_own_paths() const { return false; }
 };
 
 // The strategy for `config.kind()`.

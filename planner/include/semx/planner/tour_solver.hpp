@@ -34,4 +34,10 @@ Tour solve_open_tour(const TourProblem& p, int exact_max, int first = -1);
 Tour exact_open_tour(const TourProblem& p, int first = -1);
 Tour heuristic_open_tour(const TourProblem& p, int first = -1);
 
+// The same on a square matrix cost[i][j], the order starting with node 0 (the known-map oracle's
+// form: it keeps the matrix to fly and report the tour).
+Tour solve_tour(const std::vector<std::vector<double>>& cost, int exact_max);
+// The summed cost of consecutive pairs of `order`.
+double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector<int>& order);
+
 }  // namespace semx::planner

@@ -1,0 +1,953 @@
+#include "semx/planner/oracle_strategy.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "semx/core/angles.hpp"
+#include "semx/core/stopwatch.hpp"
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/set_cover.hpp"
+#include "semx/planner/tour_solver.hpp"
+#include "semx/planner/travel_cost.hpp"
+
+namespace semx::planner {
+
+namespace {
+
+// Cell flags of the dense truth.
+constexpr uint8_t kOccupied = 1;  // a true occupied voxel: rays end in it
+constexpr uint8_t kTarget = 2;    // in T
+constexpr uint8_t kBorder = 4;    // the layer around the truth's box: rays leave the world there
+constexpr uint8_t kPassable = 8;  // a path may pass through its centre
+
+constexpr float kUnreached = std::numeric_limits<float>::infinity();
+// Waypoints of one path at most: the controller takes 200 (docs/controller.md, "bad path").
+constexpr size_t kMaxWaypoints = 150;
+
+struct Move {
+  int dx, dy, dz;
+  double length;  // in voxels
+};
+
+std::vector<Move> make_moves() {
+  std::vector<Move> m;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dx || dy || dz) m.push_back({dx, dy, dz, std::sqrt(double(dx * dx + dy * dy + dz * dz))});
+  return m;
+}
+
+const std::vector<Move>& moves() {
+  static const std::vector<Move> m = make_moves();
+  return m;
+}
+
+}  // namespace
+
+// Everything derived from the truth: the dense grid of flags, the clearance, the path graph, the
+// camera's rays, the candidates.
+struct OracleStrategy::Model {
+  Model(const TruthMap& truth, const PlannerConfig& config);
+
+  double res = 0.1;
+  map::VoxelKey origin;  // key of dense cell (0, 0, 0): the truth's min_key minus the border layer
+  int nx = 0, ny = 0, nz = 0;
+  int64_t sy = 0, sz = 0;
+  size_t n = 0;
+  std::vector<uint8_t> flags;
+  std::vector<int32_t> target_id;  // per cell, -1 outside T
+  std::vector<int64_t> targets;    // cell of each T id
+  std::vector<float> clear;        // the checker's ESDF at the cell's centre (capped), -1 in solids
+  std::vector<float> factor;       // path cost per metre through the cell
+  std::vector<uint32_t> allowed;   // bit k: moves()[k] from this cell keeps to passable cells
+  std::vector<int64_t> move_offset;
+  std::vector<double> move_length;  // m
+  std::vector<float> move_cost;     // half the length: a move costs it times the two cells' factors
+  mutable std::vector<float> search_cost;  // scratch of search()
+  mutable std::vector<uint8_t> search_want;
+  map::StateGrid grid;              // the truth as a map (outside the box unknown: an obstacle)
+  CollisionChecker checker;
+  double cap = 0.6;  // clearances are exact up to this
+
+  // The camera: rays from a cell's centre, each a run of steps.
+  struct Step {
+    int32_t offset;  // cell index difference from the ray's origin
+    uint32_t free_mask;   // yaw bins that observe the cell when the ray passes through it
+    uint32_t hit_mask;    // ... when the ray's return ends in it
+    uint32_t valid_mask;  // ... for which a return in it is not nearer than min_range
+  };
+  std::vector<Step> steps;
+  std::vector<uint32_t> ray_begin;
+  std::vector<uint32_t> frustum;  // per ray, the bins whose frustum holds it
+  // Per ray, the first step from which a return is never nearer than min_range for any bin
+  // (valid_mask == frustum): only the voxels before it wait to learn whether the ray counts.
+  std::vector<uint32_t> valid_from;
+  int bins = 32;
+  std::vector<uint32_t> vmask;  // scratch of cast()
+  std::vector<int64_t> touched;
+  std::vector<std::pair<int64_t, uint32_t>> ray_buffer;
+
+  std::vector<int64_t> candidates;  // cells
+  std::vector<uint8_t> observable;  // per T id
+  std::vector<float> start_length;  // path length from the start's entry cell, per cell (m)
+
+  map::VoxelKey key_of(int64_t i) const {
+    const int64_t z = i / sz, y = (i - z * sz) / sy, x = i - z * sz - y * sy;
+    return {origin.x + static_cast<int32_t>(x), origin.y + static_cast<int32_t>(y),
+            origin.z + static_cast<int32_t>(z)};
+  }
+  int64_t index_of(const map::VoxelKey& k) const {
+    const int64_t x = k.x - origin.x, y = k.y - origin.y, z = k.z - origin.z;
+    if (x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz) return -1;
+    return x + y * sy + z * sz;
+  }
+  int64_t index_of(const Eigen::Vector3d& p) const { return p.allFinite() ? index_of(grid.keys().key(p)) : -1; }
+  Eigen::Vector3d centre(int64_t i) const { return grid.keys().center(key_of(i)); }
+
+  void build_rays(const GainConfig& g, const OracleConfig& o);
+  // What the camera at cell o's centre sees of T, every yaw bin at once.
+  void cast(int64_t o, std::vector<MaskedElement>& out);
+  // Dijkstra (target < 0: everything; else A* toward it) from `source` over passable cells on
+  // cost = length x factor; `length` gets each settled cell's path length (m), `parent` its
+  // predecessor. Stops when every cell of `wanted` (if any) is settled.
+  void search(int64_t source, int64_t target, std::vector<float>& length, std::vector<int32_t>* parent,
+              const std::vector<int64_t>* wanted = nullptr) const;
+  // The passable cell where a path from p starts: p's own, else the nearest within 1 m.
+  int64_t entry(const Eigen::Vector3d& p) const;
+  // Every point of a-b keeps `need` of clearance (the checker's ESDF) and the bare body box is
+  // free of true occupied voxels, at points 5 cm apart.
+  bool segment_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double need) const;
+};
+
+OracleStrategy::Model::Model(const TruthMap& truth, const PlannerConfig& config)
+    : res(truth.resolution()), grid(truth.resolution()), checker(config.collision) {
+  const map::VoxelKey lo = truth.min_key(), d = truth.dims();
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0) throw std::invalid_argument("oracle: the truth's box is empty");
+  origin = {lo.x - 1, lo.y - 1, lo.z - 1};
+  nx = d.x + 2;
+  ny = d.y + 2;
+  nz = d.z + 2;
+  sy = nx;
+  sz = static_cast<int64_t>(nx) * ny;
+  n = static_cast<size_t>(sz) * nz;
+  if (n >= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
+    throw std::invalid_argument("oracle: the truth's box is too large");
+  flags.assign(n, 0);
+  target_id.assign(n, -1);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const int64_t i = x + y * sy + z * sz;
+        if (x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1) {
+          flags[static_cast<size_t>(i)] = kBorder;
+          continue;
+        }
+        const map::VoxelKey k{origin.x + x, origin.y + y, origin.z + z};
+        const bool occ = truth.occupied(k);
+        grid.set_state(k, occ ? map::VoxelState::kOccupied : map::VoxelState::kFree);
+        uint8_t f = occ ? kOccupied : 0;
+        if (truth.target(k)) {
+          f |= kTarget;
+          target_id[static_cast<size_t>(i)] = static_cast<int32_t>(targets.size());
+          targets.push_back(i);
+        }
+        flags[static_cast<size_t>(i)] = f;
+      }
+  checker.set_grid(&grid);
+  cap = checker.cached_cap();
+  const double pref = std::min(config.oracle.preferred_clearance, cap);
+  clear.assign(n, -1.0f);
+  factor.assign(n, 1.0f);
+  for (size_t i = 0; i < n; ++i) {
+    if (flags[i] & (kOccupied | kBorder)) continue;
+    const Eigen::Vector3d c = centre(static_cast<int64_t>(i));
+    const double e = checker.esdf(c, cap);
+    clear[i] = static_cast<float>(e);
+    factor[i] = static_cast<float>(1.0 + config.oracle.clearance_penalty * std::max(0.0, pref - e));
+    // A path point keeps what DEP's doorway points keep (door_clearance in the controller's
+    // measure, the bare body box free): narrower than that no planner's path may pass.
+    if (e >= config.collision.door_clearance && checker.vehicle_free(c)) flags[i] |= kPassable;
+  }
+  for (const Move& m : moves()) {
+    move_offset.push_back(m.dx + m.dy * sy + m.dz * sz);
+    move_length.push_back(m.length * res);
+    move_cost.push_back(static_cast<float>(0.5 * m.length * res));
+  }
+  // A move is allowed when every cell of its bounding box is passable: a diagonal step cannot cut
+  // the corner of a cell a path may not pass through.
+  allowed.assign(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (!(flags[i] & kPassable)) continue;
+    uint32_t bits = 0;
+    for (size_t k = 0; k < moves().size(); ++k) {
+      const Move& m = moves()[k];
+      bool ok = true;
+      for (int az = 0; az <= std::abs(m.dz) && ok; ++az)
+        for (int ay = 0; ay <= std::abs(m.dy) && ok; ++ay)
+          for (int ax = 0; ax <= std::abs(m.dx) && ok; ++ax) {
+            if (!ax && !ay && !az) continue;
+            const int64_t j = static_cast<int64_t>(i) + (m.dx < 0 ? -ax : ax) + (m.dy < 0 ? -ay : ay) * sy +
+                              (m.dz < 0 ? -az : az) * sz;
+            ok = flags[static_cast<size_t>(j)] & kPassable;
+          }
+      if (ok) bits |= 1u << k;
+    }
+    allowed[i] = bits;
+  }
+  build_rays(config.gain, config.oracle);
+  vmask.assign(n, 0);
+}
+
+void OracleStrategy::Model::build_rays(const GainConfig& g, const OracleConfig& o) {
+  // The camera's frustum at yaw psi_b = b * 2 pi / bins: a direction at azimuth a and elevation e
+  // is in the image when, with r = a - psi_b, cos r > 0, |tan r| <= tan(hfov / 2) and
+  // |tan e| <= tan(vfov / 2) cos r (pinhole, level with the body); its z-depth per metre along
+  // the ray is c = cos e cos r. The mapper's rules (docs/mapper.md): a return with z-depth in
+  // [min_range, max_range] observes the voxels the ray crosses and the one it ends in; none
+  // within max_range observes the voxels up to z = max_range but not the one holding that point;
+  // a return nearer than min_range observes nothing.
+  bins = g.yaw_bins;
+  const double tan_h = std::tan(0.5 * g.horizontal_fov()), tan_v = std::tan(0.5 * g.vertical_fov());
+  const double half_el = std::atan(tan_v);
+  const double minr = g.min_range, maxr = g.max_range;
+  steps.clear();
+  ray_begin.assign(1, 0);
+  frustum.clear();
+  std::vector<double> c(static_cast<size_t>(bins));
+  for (int j = 0; j < o.rays_elevation; ++j) {
+    const double el = -half_el + (j + 0.5) * 2.0 * half_el / o.rays_elevation;
+    for (int i = 0; i < o.rays_azimuth; ++i) {
+      const double az = (i + 0.5) * 2.0 * M_PI / o.rays_azimuth;
+      uint32_t in = 0;
+      double c_max = 0.0;
+      for (int b = 0; b < bins; ++b) {
+        const double r = core::wrap_angle(az - b * 2.0 * M_PI / bins);
+        c[static_cast<size_t>(b)] = 0.0;
+        if (std::cos(r) <= 1e-9 || std::abs(std::tan(r)) > tan_h + 1e-12 ||
+            std::abs(std::tan(el)) > tan_v * std::cos(r) + 1e-12)
+          continue;
+        in |= 1u << b;
+        c[static_cast<size_t>(b)] = std::cos(el) * std::cos(r);
+        c_max = std::max(c_max, c[static_cast<size_t>(b)]);
+      }
+      if (!in) continue;
+      const double reach = maxr / c_max;  // m: no bin observes anything farther along this ray
+      auto mask = [&](auto&& pred) {
+        uint32_t m = 0;
+        for (int b = 0; b < bins; ++b)
+          if ((in >> b & 1u) && pred(c[static_cast<size_t>(b)])) m |= 1u << b;
+        return m;
+      };
+      // 3-D DDA in voxel units from the centre of the origin's voxel.
+      const double d[3] = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+      int cell[3] = {0, 0, 0}, step[3];
+      double t_next[3], t_delta[3];
+      for (int a = 0; a < 3; ++a) {
+        step[a] = d[a] > 0 ? 1 : -1;
+        t_delta[a] = std::abs(d[a]) > 1e-12 ? 1.0 / std::abs(d[a]) : std::numeric_limits<double>::infinity();
+        t_next[a] = 0.5 * t_delta[a];
+      }
+      double t_entry = 0.0;
+      while (t_entry * res <= reach) {
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+          if (t_next[a] < t_next[axis]) axis = a;
+        const double t_exit = t_next[axis];
+        const double e = t_entry * res, x = t_exit * res;
+        Step s;
+        s.offset = static_cast<int32_t>(cell[0] + cell[1] * sy + cell[2] * sz);
+        s.free_mask = mask([&](double cb) { return x * cb <= maxr; });
+        s.valid_mask = mask([&](double cb) { return e * cb >= minr; });
+        s.hit_mask = mask([&](double cb) { return e * cb <= maxr; }) & s.valid_mask;
+        steps.push_back(s);
+        cell[axis] += step[axis];
+        t_next[axis] += t_delta[axis];
+        t_entry = t_exit;
+      }
+      uint32_t vf = ray_begin.back();
+      while (vf < steps.size() && steps[vf].valid_mask != in) ++vf;
+      valid_from.push_back(vf);
+      ray_begin.push_back(static_cast<uint32_t>(steps.size()));
+      frustum.push_back(in);
+    }
+  }
+}
+
+void OracleStrategy::Model::cast(int64_t o, std::vector<MaskedElement>& out) {
+  out.clear();
+  auto mark = [&](int64_t i, uint32_t m) {
+    uint32_t& v = vmask[static_cast<size_t>(i)];
+    if (!v) touched.push_back(i);
+    v |= m;
+  };
+  for (size_t r = 0; r + 1 < ray_begin.size(); ++r) {
+    // Near the origin a return may be too near for some bins (min_range), which decides whether
+    // the voxels before it count: they wait in the buffer until the ray's end or valid_from.
+    ray_buffer.clear();
+    uint32_t s = ray_begin[r];
+    const uint32_t end = ray_begin[r + 1], vf = valid_from[r];
+    bool ended = false;
+    uint32_t valid = frustum[r];
+    for (; s < end && s < vf; ++s) {
+      const Step& st = steps[s];
+      const int64_t i = o + st.offset;
+      const uint8_t f = flags[static_cast<size_t>(i)];
+      if (f & kBorder) {  // out of the world: no return
+        ended = true;
+        break;
+      }
+      if (f & kOccupied) {
+        valid = st.valid_mask;
+        if ((f & kTarget) && st.hit_mask) ray_buffer.emplace_back(i, st.hit_mask);
+        ended = true;
+        break;
+      }
+      if ((f & kTarget) && st.free_mask) ray_buffer.emplace_back(i, st.free_mask);
+    }
+    for (const auto& [i, m] : ray_buffer)
+      if (m & valid) mark(i, m & valid);
+    if (ended) continue;
+    for (; s < end; ++s) {
+      const Step& st = steps[s];
+      const int64_t i = o + st.offset;
+      const uint8_t f = flags[static_cast<size_t>(i)];
+      if (f & kBorder) break;
+      if (f & kOccupied) {
+        if ((f & kTarget) && st.hit_mask) mark(i, st.hit_mask);
+        break;
+      }
+      if ((f & kTarget) && st.free_mask) mark(i, st.free_mask);
+    }
+  }
+  for (int64_t i : touched) {
+    out.push_back({target_id[static_cast<size_t>(i)], vmask[static_cast<size_t>(i)]});
+    vmask[static_cast<size_t>(i)] = 0;
+  }
+  touched.clear();
+}
+
+void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<float>& length,
+                                   std::vector<int32_t>* parent, const std::vector<int64_t>* wanted) const {
+  std::vector<float>& cost = search_cost;
+  cost.assign(n, kUnreached);
+  length.assign(n, kUnreached);
+  if (parent) parent->assign(n, -1);
+  size_t left = 0;
+  std::vector<uint8_t>& want = search_want;
+  if (wanted) {
+    want.assign(n, 0);
+    for (int64_t w : *wanted)
+      if (w >= 0 && !want[static_cast<size_t>(w)]) want[static_cast<size_t>(w)] = 1, ++left;
+  }
+  const Eigen::Vector3d goal = target >= 0 ? centre(target) : Eigen::Vector3d::Zero();
+  // A*'s heuristic: the straight distance, a lower bound (every factor is at least 1).
+  auto h = [&](int64_t i) { return target >= 0 ? static_cast<float>((centre(i) - goal).norm()) : 0.0f; };
+  // Entries (cost + heuristic, cell); one whose cost is no longer the cell's is stale.
+  using Entry = std::pair<float, int32_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  cost[static_cast<size_t>(source)] = 0.0f;
+  length[static_cast<size_t>(source)] = 0.0f;
+  open.emplace(h(source), static_cast<int32_t>(source));
+  while (!open.empty()) {
+    const auto [key, i32] = open.top();
+    open.pop();
+    const int64_t i = i32;
+    const size_t u = static_cast<size_t>(i);
+    if (key > cost[u] + h(i) + 1e-4f) continue;  // stale
+    if (i == target) return;
+    if (wanted && want[u]) {
+      want[u] = 0;
+      if (--left == 0) return;
+    }
+    // The source may lie off the graph (a vehicle that braked near a wall): it leaves by any move
+    // into a passable cell.
+    const uint32_t bits = (flags[u] & kPassable) ? allowed[u] : ~0u;
+    const float fu = factor[u], cu = cost[u], lu = length[u];
+    for (uint32_t b = bits & ((1u << move_offset.size()) - 1); b; b &= b - 1) {
+      const size_t k = static_cast<size_t>(__builtin_ctz(b));
+      const size_t v = static_cast<size_t>(i + move_offset[k]);
+      if (!(flags[v] & kPassable)) continue;
+      const float c = cu + move_cost[k] * (fu + factor[v]);
+      if (c < cost[v]) {
+        cost[v] = c;
+        length[v] = lu + static_cast<float>(move_length[k]);
+        if (parent) (*parent)[v] = i32;
+        open.emplace(c + h(static_cast<int64_t>(v)), static_cast<int32_t>(v));
+      }
+    }
+  }
+}
+
+int64_t OracleStrategy::Model::entry(const Eigen::Vector3d& p) const {
+  const int64_t i = index_of(p);
+  if (i < 0) return -1;
+  if (flags[static_cast<size_t>(i)] & kPassable) return i;
+  const int r = static_cast<int>(std::ceil(1.0 / res));
+  const map::VoxelKey k = key_of(i);
+  int64_t best = -1;
+  double best_d = 0.0;
+  for (int dz = -r; dz <= r; ++dz)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int64_t j = index_of(map::VoxelKey{k.x + dx, k.y + dy, k.z + dz});
+        if (j < 0 || !(flags[static_cast<size_t>(j)] & kPassable)) continue;
+        const double d = (centre(j) - p).squaredNorm();
+        if (d <= 1.0 && (best < 0 || d < best_d)) best = j, best_d = d;
+      }
+  return best;
+}
+
+bool OracleStrategy::Model::segment_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double need) const {
+  const double len = (b - a).norm();
+  const int k = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+  for (int s = 0; s <= k; ++s) {
+    const Eigen::Vector3d p = a + (static_cast<double>(s) / k) * (b - a);
+    if (checker.esdf(p, cap) < need - 1e-6 || !checker.vehicle_free(p)) return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+std::string OracleSummary::describe() const {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(2);
+  if (!ready) {
+    s << "oracle (reads the ground truth): no plan: " << error;
+    return s.str();
+  }
+  s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
+    << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
+    << first_pass << " in the first pass) see " << 100.0 * cover_share() << " % of that (" << cover_dropped
+    << " redundant dropped); tour "
+    << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
+    << "; prepared in " << prepare_ms / 1000.0 << " s";
+  return s.str();
+}
+
+OracleStrategy::OracleStrategy(const PlannerConfig& config) : config_(config) {
+  if (config.gain.yaw_bins > 32) throw std::invalid_argument("oracle: gain.yaw_bins must be at most 32");
+}
+
+OracleStrategy::~OracleStrategy() = default;
+
+void OracleStrategy::set_truth(const TruthMap* truth) {
+  truth_ = truth;
+  model_.reset();
+  reset();
+}
+
+void OracleStrategy::reset() {
+  summary_ = OracleSummary();
+  tour_.clear();
+  tour_elements_.clear();
+  holders_.clear();
+  picks_.clear();
+  tour_costs_.clear();
+  tour_order_.clear();
+  next_ = 0;
+  chain_end_ = 0;
+  attempts_ = 0;
+  skipped_ = 0;
+  prepared_ = false;
+}
+
+namespace {
+
+// The candidates as set-cover groups: a viewpoint, its yaw bins the members.
+class ViewSource : public CoverSource {
+ public:
+  ViewSource(std::function<void(int, std::vector<MaskedElement>&)> cast, int groups, int members)
+      : cast_(std::move(cast)), groups_(groups), members_(members) {}
+  int groups() const override { return groups_; }
+  int members() const override { return members_; }
+  void elements(int group, std::vector<MaskedElement>& out) override { cast_(group, out); }
+
+ private:
+  std::function<void(int, std::vector<MaskedElement>&)> cast_;
+  int groups_, members_;
+};
+
+}  // namespace
+
+bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
+  reset();
+  prepared_ = true;
+  core::Stopwatch watch;
+  if (!truth_) {
+    summary_.error = "no ground truth (semx-planner needs --world FILE)";
+    return false;
+  }
+  if (!model_) model_ = std::make_unique<Model>(*truth_, config_);
+  fprintf(stderr, "TIMING model %.1f ms\n", watch.ms());
+  Model& m = *model_;
+  summary_.target = static_cast<int64_t>(m.targets.size());
+
+  // The start and what the vehicle can reach from it.
+  const int64_t s = m.entry(start);
+  if (s < 0) {
+    summary_.error = "the start is not within 1 m of the true free space a path may take";
+    return false;
+  }
+  m.search(s, -1, m.start_length, nullptr);
+
+  // 1. Candidates: the lattice, each point moved to the nearest cell around it where DEP would
+  // accept a goal (node_free on the truth) and that the vehicle reaches.
+  const OracleConfig& oc = config_.oracle;
+  const int sxy = std::max(1, static_cast<int>(std::lround(oc.spacing / m.res)));
+  const int sz = std::max(1, static_cast<int>(std::lround(oc.height_step / m.res)));
+  std::vector<int8_t> ok(m.n, -1);
+  auto goal_ok = [&](int64_t i) {
+    int8_t& v = ok[static_cast<size_t>(i)];
+    if (v < 0) {
+      const Eigen::Vector3d c = m.centre(i);
+      v = (m.flags[static_cast<size_t>(i)] & kPassable) && m.start_length[static_cast<size_t>(i)] < kUnreached &&
+          m.clear[static_cast<size_t>(i)] >= config_.collision.clearance && c.z() >= config_.sampling.z_min &&
+          c.z() <= config_.sampling.z_max && m.checker.node_free(c);
+    }
+    return v == 1;
+  };
+  std::unordered_set<int64_t> chosen;
+  m.candidates.clear();
+  const map::VoxelKey lo = truth_->min_key(), d = truth_->dims();
+  for (double z = config_.sampling.z_min; z <= config_.sampling.z_max + 1e-9; z += oc.height_step) {
+    const int32_t kz = static_cast<int32_t>(std::floor(z / m.res));
+    for (int32_t ky = lo.y + sxy / 2; ky < lo.y + d.y; ky += sxy)
+      for (int32_t kx = lo.x + sxy / 2; kx < lo.x + d.x; kx += sxy) {
+        const int64_t c = m.index_of(map::VoxelKey{kx, ky, kz});
+        if (c < 0) continue;
+        int64_t best = goal_ok(c) ? c : -1;
+        double best_d = 0.0;
+        if (best < 0) {
+          for (int dz = -sz / 2; dz <= sz / 2; ++dz)
+            for (int dy = -sxy / 2; dy <= sxy / 2; ++dy)
+              for (int dx = -sxy / 2; dx <= sxy / 2; ++dx) {
+                const int64_t j = m.index_of(map::VoxelKey{kx + dx, ky + dy, kz + dz});
+                if (j < 0 || !goal_ok(j)) continue;
+                const double dd = double(dx * dx + dy * dy + dz * dz);
+                if (best < 0 || dd < best_d) best = j, best_d = dd;
+              }
+        }
+        if (best >= 0 && chosen.insert(best).second) m.candidates.push_back(best);
+      }
+  }
+  summary_.candidates = static_cast<int64_t>(m.candidates.size());
+  fprintf(stderr, "TIMING candidates %zu %.1f ms rays %zu steps %zu\n", m.candidates.size(), watch.ms(), m.frustum.size(), m.steps.size());
+  if (m.candidates.empty()) {
+    summary_.error = "no viewpoint on the true free space the vehicle can reach";
+    return false;
+  }
+
+  // 2. What each candidate sees, at every yaw bin. The first pass and the cover ask for a
+  // candidate's view again and again: kept, up to oracle.cache_mb, a view is cast once (the same
+  // lists either way).
+  const int bins = m.bins;
+  const size_t groups = m.candidates.size();
+  m.observable.assign(m.targets.size(), 0);
+  std::vector<std::vector<MaskedElement>> cache(groups);
+  std::vector<uint8_t> cached(groups, 0);
+  const size_t budget = static_cast<size_t>(oc.cache_mb) << 20;
+  size_t used = 0;
+  ViewSource source(
+      [&](int g, std::vector<MaskedElement>& out) {
+        const size_t i = static_cast<size_t>(g);
+        if (cached[i]) {
+          out = cache[i];
+          return;
+        }
+        m.cast(m.candidates[i], out);
+        if (used + out.size() * sizeof(MaskedElement) <= budget) {
+          used += out.size() * sizeof(MaskedElement);
+          cache[i] = out;
+          cached[i] = 1;
+        }
+      },
+      static_cast<int>(groups), bins);
+  std::vector<MaskedElement> els;
+  std::vector<int64_t> bound(groups * static_cast<size_t>(bins), 0);  // T voxels (g, b) shows, at most
+  int64_t observable = 0;
+  for (size_t g = 0; g < groups; ++g) {
+    source.elements(static_cast<int>(g), els);
+    for (const MaskedElement& e : els) {
+      if (!m.observable[static_cast<size_t>(e.element)]) m.observable[static_cast<size_t>(e.element)] = 1, ++observable;
+      for (uint32_t x = e.members; x; x &= x - 1) ++bound[g * static_cast<size_t>(bins) + static_cast<size_t>(__builtin_ctz(x))];
+    }
+  }
+  auto yaw_of = [&](int b) { return b * 2.0 * M_PI / bins; };
+
+  // 3. The first pass: from the vehicle, the view (candidate, yaw) that shows the most T voxels
+  // not yet shown per second of travel (travel_time() of the path length on the true free space
+  // and the turn), again and again, until oracle.first_pass of the observable part is shown. What
+  // a view shows only shrinks as more is shown, so a ratio computed earlier is an upper bound:
+  // only the views whose bound comes first are counted again (from the cache).
+  std::vector<uint8_t> shown(m.targets.size(), 0);
+  std::vector<std::pair<int, int>> walk;  // (candidate, bin)
+  {
+    int64_t have = 0;
+    const auto want = static_cast<int64_t>(std::ceil(oc.first_pass * static_cast<double>(observable)));
+    int64_t cur = s;
+    double cur_yaw = start_yaw;
+    std::vector<float> len;
+    std::vector<int64_t> gains(static_cast<size_t>(bins));
+    std::vector<int> counted(groups, -1);  // the step at which a candidate was last counted
+    for (int step = 0; have < want; ++step) {
+      m.search(cur, -1, len, nullptr);
+      auto time_to = [&](size_t g, int b) {
+        const float l = len[static_cast<size_t>(m.candidates[g])];
+        return l < kUnreached ? travel_time(l, cur_yaw, yaw_of(b), config_.cost) : -1.0;
+      };
+      using Entry = std::tuple<double, int, int, bool>;  // ratio (bound), candidate, bin, exact
+      std::priority_queue<Entry> heap;
+      for (size_t g = 0; g < groups; ++g)
+        for (int b = 0; b < bins; ++b) {
+          const int64_t gb = bound[g * static_cast<size_t>(bins) + static_cast<size_t>(b)];
+          const double t = gb > 0 ? time_to(g, b) : -1.0;
+          if (t > 0) heap.emplace(static_cast<double>(gb) / t, static_cast<int>(g), b, false);
+        }
+      int pick_g = -1, pick_b = -1;
+      while (!heap.empty()) {
+        const auto [ratio, g, b, exact] = heap.top();
+        heap.pop();
+        if (exact) {
+          pick_g = g;
+          pick_b = b;
+          break;
+        }
+        if (counted[static_cast<size_t>(g)] == step) continue;  // its exact entries are in the heap
+        counted[static_cast<size_t>(g)] = step;
+        source.elements(g, els);
+        std::fill(gains.begin(), gains.end(), 0);
+        for (const MaskedElement& e : els)
+          if (!shown[static_cast<size_t>(e.element)])
+            for (uint32_t x = e.members; x; x &= x - 1) ++gains[static_cast<size_t>(__builtin_ctz(x))];
+        for (int k = 0; k < bins; ++k) {
+          bound[static_cast<size_t>(g) * static_cast<size_t>(bins) + static_cast<size_t>(k)] = gains[static_cast<size_t>(k)];
+          const double t = gains[static_cast<size_t>(k)] > 0 ? time_to(static_cast<size_t>(g), k) : -1.0;
+          if (t > 0) heap.emplace(static_cast<double>(gains[static_cast<size_t>(k)]) / t, g, k, true);
+        }
+        (void)ratio;
+      }
+      if (pick_g < 0) break;
+      source.elements(pick_g, els);
+      for (const MaskedElement& e : els)
+        if ((e.members >> pick_b & 1u) && !shown[static_cast<size_t>(e.element)])
+          shown[static_cast<size_t>(e.element)] = 1, ++have;
+      walk.emplace_back(pick_g, pick_b);
+      summary_.tour_length += len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
+      summary_.tour_time += time_to(static_cast<size_t>(pick_g), pick_b);
+      cur = m.candidates[static_cast<size_t>(pick_g)];
+      cur_yaw = yaw_of(pick_b);
+    }
+  }
+
+  // 4. The cover of the rest: greedy picks until cover_fraction of the observable part is shown,
+  // what the first pass showed counting.
+  const CoverResult cover = greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction, &shown);
+  summary_.observable = cover.observable;
+  summary_.covered = cover.covered;
+  summary_.first_pass = static_cast<int64_t>(walk.size());
+  summary_.viewpoints = static_cast<int64_t>(walk.size() + cover.picks.size());
+  summary_.cover_dropped = cover.dropped;
+  fprintf(stderr, "TIMING cover walk %zu picks %zu evals %lld %.1f ms cache %zu MB\n", walk.size(), cover.picks.size(), (long long)cover.evaluations, watch.ms(), used >> 20);
+
+  // 5. The tour of the picks, from where the first pass ended: node 0 that place, node i pick
+  // i - 1. Path lengths from one search per distinct cell (a place picked at several yaws is one).
+  const size_t k = cover.picks.size();
+  std::vector<int64_t> cell(k + 1);
+  std::vector<double> yaw(k + 1);
+  cell[0] = walk.empty() ? s : m.candidates[static_cast<size_t>(walk.back().first)];
+  yaw[0] = walk.empty() ? start_yaw : yaw_of(walk.back().second);
+  for (size_t i = 0; i < k; ++i) {
+    cell[i + 1] = m.candidates[static_cast<size_t>(cover.picks[i].group)];
+    yaw[i + 1] = yaw_of(cover.picks[i].member);
+  }
+  std::vector<std::vector<double>> length(k + 1, std::vector<double>(k + 1, 0.0));
+  {
+    std::vector<int64_t> wanted(cell.begin() + 1, cell.end());
+    std::vector<float> len;
+    for (size_t i = 0; i <= k; ++i) {
+      bool same = false;
+      for (size_t j = 0; j < i && !same; ++j) {
+        if (cell[j] == cell[i]) {
+          length[i] = length[j];
+          same = true;
+        }
+      }
+      if (same) continue;
+      m.search(cell[i], -1, len, nullptr, &wanted);
+      for (size_t j = 1; j <= k; ++j) length[i][j] = len[static_cast<size_t>(cell[j])];
+    }
+  }
+  std::vector<std::vector<double>> cost(k + 1, std::vector<double>(k + 1, 0.0));
+  for (size_t i = 0; i <= k; ++i)
+    for (size_t j = 1; j <= k; ++j) {
+      const double l = std::isfinite(length[i][j]) ? length[i][j] : 1e6;
+      cost[i][j] = i == j ? 0.0 : travel_time(l, yaw[i], yaw[j], config_.cost);
+    }
+  for (size_t i = 1; i <= k; ++i) cost[i][0] = cost[0][i];  // never used: the tour does not return
+  const Tour t = solve_tour(cost, oc.exact_tour_max);
+  fprintf(stderr, "TIMING tour %.1f ms\n", watch.ms());
+  picks_ = cover.picks;
+  tour_costs_ = cost;
+  tour_order_ = t.order;
+  summary_.tour_exact = t.exact;
+
+  // The viewpoints in the order flown: the first pass's, then the tour's.
+  holders_.assign(m.targets.size(), 0);
+  auto add = [&](int g, int b, int64_t gain) {
+    OracleViewpoint v;
+    v.position = m.centre(m.candidates[static_cast<size_t>(g)]);
+    v.yaw = core::wrap_angle(yaw_of(b));
+    v.gain = gain;
+    tour_.push_back(v);
+    source.elements(g, els);
+    std::vector<int32_t> own;
+    for (const MaskedElement& e : els)
+      if (e.members >> b & 1u) {
+        own.push_back(e.element);
+        if (holders_[static_cast<size_t>(e.element)] < UINT16_MAX) ++holders_[static_cast<size_t>(e.element)];
+      }
+    tour_elements_.push_back(std::move(own));
+  };
+  {
+    std::vector<uint8_t> seen(m.targets.size(), 0);
+    for (const auto& [g, b] : walk) {
+      source.elements(g, els);
+      int64_t gain = 0;
+      for (const MaskedElement& e : els)
+        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++gain;
+      add(g, b, gain);
+    }
+  }
+  summary_.tour_time += t.cost;
+  for (size_t q = 1; q < t.order.size(); ++q) {
+    const size_t i = static_cast<size_t>(t.order[q]);
+    summary_.tour_length += length[static_cast<size_t>(t.order[q - 1])][i];
+    add(cover.picks[i - 1].group, cover.picks[i - 1].member, cover.picks[i - 1].gain);
+  }
+  cache.clear();
+  summary_.ready = true;
+  summary_.prepare_ms = watch.ms();
+  return true;
+}
+
+std::vector<Eigen::Vector3d> OracleStrategy::truth_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  if (!model_) return {};
+  const Model& m = *model_;
+  const int64_t s = m.entry(from), g = m.index_of(to);
+  if (s < 0 || g < 0 || !(m.flags[static_cast<size_t>(g)] & kPassable)) return {};
+  std::vector<float> len;
+  std::vector<int32_t> parent;
+  if (s != g) {
+    m.search(s, g, len, &parent);
+    if (parent[static_cast<size_t>(g)] < 0) return {};
+  }
+  // The cells, vehicle first; then pulled straight: from each kept point the farthest point of the
+  // cell path (within 4 m) that a segment reaches keeping the clearance the cell path had over
+  // that stretch (at most preferred_clearance), so a shortcut never comes nearer a wall than the
+  // search chose to.
+  std::vector<int64_t> cells;
+  for (int64_t i = g; i >= 0 && i != s; i = parent[static_cast<size_t>(i)]) cells.push_back(i);
+  cells.push_back(s);
+  std::reverse(cells.begin(), cells.end());
+  std::vector<Eigen::Vector3d> pts{from};
+  std::vector<double> clear{m.checker.esdf(from, m.cap)};
+  for (int64_t c : cells) {
+    pts.push_back(m.centre(c));
+    clear.push_back(m.clear[static_cast<size_t>(c)]);
+  }
+  pts.back() = to;
+  const double pref = std::min(config_.oracle.preferred_clearance, m.cap);
+  std::vector<Eigen::Vector3d> out{from};
+  size_t i = 0;
+  while (i + 1 < pts.size()) {
+    size_t best = i + 1;
+    double need = std::min({pref, clear[i], clear[i + 1]});
+    for (size_t j = i + 2; j < pts.size(); ++j) {
+      if ((pts[j] - pts[i]).norm() > 4.0) break;
+      need = std::min(need, clear[j]);
+      if (!m.segment_ok(pts[i], pts[j], need)) break;
+      best = j;
+    }
+    if ((pts[best] - out.back()).norm() > 1e-6) out.push_back(pts[best]);
+    i = best;
+  }
+  if (out.size() == 1 && (to - from).norm() > 1e-6) out.push_back(to);
+  return out;
+}
+
+std::pair<double, double> OracleStrategy::coverage(const map::StateGrid& grid) const {
+  if (!model_ || model_->targets.empty()) return {0.0, 0.0};
+  const Model& m = *model_;
+  map::StateGrid::Reader r(grid);
+  int64_t known = 0, known_obs = 0, obs = 0;
+  for (size_t id = 0; id < m.targets.size(); ++id) {
+    const bool o = !m.observable.empty() && m.observable[id];
+    obs += o;
+    if (r.state(m.key_of(m.targets[id])) == map::VoxelState::kUnknown) continue;
+    ++known;
+    known_obs += o;
+  }
+  return {double(known) / double(m.targets.size()), obs > 0 ? double(known_obs) / double(obs) : 0.0};
+}
+
+std::vector<map::VoxelKey> OracleStrategy::seen_by(size_t i) const {
+  std::vector<map::VoxelKey> keys;
+  if (!model_ || i >= tour_elements_.size()) return keys;
+  for (int32_t e : tour_elements_[i]) keys.push_back(model_->key_of(model_->targets[static_cast<size_t>(e)]));
+  return keys;
+}
+
+std::vector<Eigen::Vector3d> OracleStrategy::candidates() const {
+  std::vector<Eigen::Vector3d> out;
+  if (model_)
+    for (int64_t c : model_->candidates) out.push_back(model_->centre(c));
+  return out;
+}
+
+std::vector<MaskedElement> OracleStrategy::candidate_view(size_t candidate) const {
+  std::vector<MaskedElement> out;
+  if (model_ && candidate < model_->candidates.size()) model_->cast(model_->candidates[candidate], out);
+  return out;
+}
+
+int64_t OracleStrategy::target_ids() const { return model_ ? static_cast<int64_t>(model_->targets.size()) : 0; }
+
+PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
+  PlanOutcome o;
+  if (!prepared_) prepare(ctx.pose.position, ctx.pose.yaw);
+  if (!summary_.ready) {
+    o.reason = summary_.describe();
+    o.finished = true;
+    return o;
+  }
+  const Model& m = *model_;
+  auto near = [&](const OracleViewpoint& v) {
+    return (ctx.pose.position - v.position).norm() <= config_.loop.goal_tolerance &&
+           core::yaw_distance(ctx.pose.yaw, v.yaw) <= config_.loop.yaw_tolerance;
+  };
+  // Past viewpoint `upto`: every viewpoint up to it is flown (or skipped), its voxels no longer
+  // count on it.
+  auto advance = [&](size_t upto, bool skip) {
+    for (; next_ <= upto && next_ < tour_.size(); ++next_) {
+      for (int32_t e : tour_elements_[next_])
+        if (holders_[static_cast<size_t>(e)] > 0) --holders_[static_cast<size_t>(e)];
+      skipped_ += skip;
+    }
+    attempts_ = 0;
+  };
+  // Whether viewpoint i still has something to show that no later viewpoint of the tour would:
+  // a T voxel it sees, unknown in the live map, that only it (of those not flown) sees.
+  auto needed = [&](size_t i) {
+    if (!ctx.grid) return true;
+    map::StateGrid::Reader r(*ctx.grid);
+    for (int32_t e : tour_elements_[i])
+      if (holders_[static_cast<size_t>(e)] == 1 &&
+          r.state(m.key_of(m.targets[static_cast<size_t>(e)])) == map::VoxelState::kUnknown)
+        return true;
+    return false;
+  };
+  if (next_ < tour_.size() && attempts_ > 0 && chain_end_ >= next_ && chain_end_ < tour_.size() &&
+      near(tour_[chain_end_]))
+    advance(chain_end_, false);
+  while (next_ < tour_.size()) {
+    if (attempts_ >= config_.oracle.max_attempts || !needed(next_)) {
+      advance(next_, true);
+      continue;
+    }
+    // The path: to the next viewpoint, then on through the following ones (oracle.chain at most)
+    // while the turn into each takes no longer than the flight to it: the controller's heading
+    // then keeps up, and the vehicle passes a viewpoint at its yaw without stopping there. A leg
+    // whose turn is longer ends the chain: the controller holds the path's end until the
+    // heading is reached.
+    std::vector<Eigen::Vector3d> path{ctx.pose.position};
+    std::vector<double> yaws{core::wrap_angle(ctx.pose.yaw)};
+    Eigen::Vector3d from = ctx.pose.position;
+    double from_yaw = ctx.pose.yaw, length = 0.0;
+    size_t end = next_;
+    int chained = 0;
+    for (size_t i = next_; i < tour_.size() && chained < config_.oracle.chain; ++i) {
+      if (i > next_ && !needed(i)) continue;
+      const OracleViewpoint& v = tour_[i];
+      std::vector<Eigen::Vector3d> leg = truth_path(from, v.position);
+      if (leg.empty() || path.size() + leg.size() > kMaxWaypoints) break;
+      double len = 0.0;
+      for (size_t k = 1; k < leg.size(); ++k) len += (leg[k] - leg[k - 1]).norm();
+      const std::vector<double> leg_yaws = interpolate_yaws(leg, from_yaw, v.yaw);
+      for (size_t k = 1; k < leg.size(); ++k) {
+        path.push_back(leg[k]);
+        yaws.push_back(leg_yaws[k]);
+      }
+      length += len;
+      end = i;
+      ++chained;
+      const bool keeps_up = core::yaw_distance(from_yaw, v.yaw) / config_.cost.yaw_rate <= len / config_.cost.velocity;
+      from = v.position;
+      from_yaw = v.yaw;
+      if (!keeps_up) break;
+    }
+    ++attempts_;
+    if (chained == 0) {
+      attempts_ = config_.oracle.max_attempts;  // unreachable from here: skip it
+      continue;
+    }
+    chain_end_ = end;
+    const OracleViewpoint& v = tour_[end];
+    Goal g;
+    g.valid = true;
+    g.node = static_cast<int64_t>(end);
+    g.position = v.position;
+    g.yaw = v.yaw;
+    for (size_t i = next_; i <= end; ++i) g.gain += static_cast<double>(tour_[i].gain);
+    g.cost = travel_time(length, ctx.pose.yaw, v.yaw, config_.cost);
+    g.score = g.gain / g.cost;
+    if (path.size() == 1) {
+      // Already there: a turn in place.
+      yaws = {core::wrap_angle(v.yaw)};
+    }
+    g.waypoints = std::move(path);
+    g.yaws = std::move(yaws);
+    o.goal = std::move(g);
+    return o;
+  }
+  o.finished = true;
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(2);
+  s << "oracle tour flown: " << tour_.size() << " viewpoints (" << skipped_ << " skipped)";
+  if (ctx.grid) {
+    const auto [t, obs] = coverage(*ctx.grid);
+    s << "; live map knows " << 100.0 * obs << " % of the observable part of T, " << 100.0 * t << " % of T";
+  }
+  s << "; " << summary_.describe();
+  o.reason = s.str();
+  return o;
+}
+
+RoadmapView OracleStrategy::roadmap(const Goal* goal) const {
+  RoadmapView v;
+  for (size_t i = 0; i < tour_.size(); ++i) {
+    RoadmapView::Node nd;
+    nd.id = static_cast<int64_t>(i);
+    nd.position = tour_[i].position;
+    nd.yaw = tour_[i].yaw;
+    nd.gain = static_cast<double>(tour_[i].gain);
+    nd.cost = 0.0;
+    if (goal && goal->valid && goal->node == nd.id) nd.flags |= kFlagGoal;
+    if (i > next_) nd.flags |= kFlagOnPath;
+    v.nodes.push_back(nd);
+    if (i > 0) v.edges.emplace_back(static_cast<int64_t>(i - 1), static_cast<int64_t>(i));
+  }
+  return v;
+}
+
+}  // namespace semx::planner

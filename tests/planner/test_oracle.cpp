@@ -1,0 +1,359 @@
+// The known-map oracle: its set cover and tour against brute force, on lists and on a tiny world,
+// and a closed loop that maps what it promised.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bitset>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "planner_test_util.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
+#include "semx/fixtures/synthetic_truth.hpp"
+#include "semx/planner/exploration_planner.hpp"
+#include "semx/planner/oracle_strategy.hpp"
+#include "semx/planner/set_cover.hpp"
+#include "semx/planner/tour_solver.hpp"
+
+namespace semx::planner {
+namespace {
+
+// ---- set cover --------------------------------------------------------------------------------
+
+// The plain (eager) greedy: every set's gain recomputed every round, ties to the lower group, then
+// member. The lazy greedy must pick the same sets (before dropping redundant ones).
+std::vector<std::pair<int, int>> eager_greedy(const std::vector<std::vector<std::vector<int32_t>>>& sets,
+                                              int32_t n, int64_t required) {
+  std::vector<uint8_t> covered(static_cast<size_t>(n), 0);
+  int64_t have = 0;
+  std::vector<std::pair<int, int>> picks;
+  while (have < required) {
+    int64_t best = 0;
+    std::pair<int, int> pick{-1, -1};
+    for (size_t g = 0; g < sets.size(); ++g)
+      for (size_t m = 0; m < sets[g].size(); ++m) {
+        std::vector<int32_t> e = sets[g][m];
+        std::sort(e.begin(), e.end());
+        e.erase(std::unique(e.begin(), e.end()), e.end());
+        int64_t gain = 0;
+        for (int32_t x : e) gain += !covered[static_cast<size_t>(x)];
+        if (gain > best) best = gain, pick = {static_cast<int>(g), static_cast<int>(m)};
+      }
+    if (best == 0) break;
+    for (int32_t x : sets[static_cast<size_t>(pick.first)][static_cast<size_t>(pick.second)])
+      if (!covered[static_cast<size_t>(x)]) covered[static_cast<size_t>(x)] = 1, ++have;
+    picks.push_back(pick);
+  }
+  return picks;
+}
+
+// The fewest sets whose union holds at least `required` elements (every subset, smallest first).
+template <size_t N>
+int brute_force_cover(const std::vector<std::bitset<N>>& sets, size_t required, int max_k) {
+  const int n = static_cast<int>(sets.size());
+  for (int k = 0; k <= max_k; ++k) {
+    std::vector<int> idx(static_cast<size_t>(k));
+    std::iota(idx.begin(), idx.end(), 0);
+    if (k > n) break;
+    while (true) {
+      std::bitset<N> u;
+      for (int i : idx) u |= sets[static_cast<size_t>(i)];
+      if (u.count() >= required) return k;
+      int i = k - 1;
+      while (i >= 0 && idx[static_cast<size_t>(i)] == n - k + i) --i;
+      if (i < 0) break;
+      ++idx[static_cast<size_t>(i)];
+      for (int j = i + 1; j < k; ++j) idx[static_cast<size_t>(j)] = idx[static_cast<size_t>(j - 1)] + 1;
+    }
+  }
+  return -1;
+}
+
+size_t covered_by(const std::vector<std::vector<std::vector<int32_t>>>& sets, const std::vector<CoverPick>& picks) {
+  std::vector<int32_t> all;
+  for (const CoverPick& p : picks)
+    for (int32_t e : sets[static_cast<size_t>(p.group)][static_cast<size_t>(p.member)]) all.push_back(e);
+  std::sort(all.begin(), all.end());
+  return static_cast<size_t>(std::unique(all.begin(), all.end()) - all.begin());
+}
+
+TEST(OracleCover, TheLazyGreedyPicksWhatThePlainGreedyPicksAndNeverMoreThanItsBound) {
+  std::mt19937 rng(7);
+  int optimal = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int32_t n = 40;
+    const int groups = 3 + trial % 4, members = 1 + trial % 3;
+    std::vector<std::vector<std::vector<int32_t>>> sets(static_cast<size_t>(groups));
+    std::vector<std::bitset<64>> flat;
+    for (auto& g : sets) {
+      g.resize(static_cast<size_t>(members));
+      for (auto& m : g) {
+        std::bitset<64> b;
+        const int size = 3 + static_cast<int>(rng() % 14);
+        for (int i = 0; i < size; ++i) {
+          const int32_t e = static_cast<int32_t>(rng() % n);
+          m.push_back(e);
+          b.set(static_cast<size_t>(e));
+        }
+        flat.push_back(b);
+      }
+    }
+    ListCoverSource source(sets);
+    const double fraction = trial % 2 ? 1.0 : 0.9;
+    const CoverResult r = greedy_cover(source, n, fraction);
+    std::bitset<64> all;
+    for (const auto& b : flat) all |= b;
+    EXPECT_EQ(r.observable, static_cast<int64_t>(all.count()));
+    EXPECT_EQ(r.required, static_cast<int64_t>(std::ceil(fraction * static_cast<double>(all.count()) - 1e-9)));
+    // What it claims is what the picks hold, and it is enough.
+    EXPECT_EQ(static_cast<int64_t>(covered_by(sets, r.picks)), r.covered);
+    EXPECT_GE(r.covered, r.required);
+    // The same picks as the eager greedy, less the dropped ones.
+    const auto eager = eager_greedy(sets, n, r.required);
+    EXPECT_EQ(static_cast<int64_t>(eager.size()), static_cast<int64_t>(r.picks.size()) + r.dropped);
+    for (const CoverPick& p : r.picks)
+      EXPECT_NE(std::find(eager.begin(), eager.end(), std::make_pair(p.group, p.member)), eager.end());
+    // Against the optimum: the greedy's ln(n) + 1 bound (for a full cover), and often equal.
+    const int best = brute_force_cover(flat, static_cast<size_t>(r.required), static_cast<int>(r.picks.size()));
+    ASSERT_GT(best, 0);
+    EXPECT_LE(static_cast<double>(r.picks.size()), best * (std::log(40.0) + 1.0));
+    optimal += static_cast<int>(r.picks.size()) == best;
+  }
+  EXPECT_GE(optimal, 25) << "of 40";
+}
+
+TEST(OracleCover, ARedundantEarlyPickIsDropped) {
+  // The greedy takes the big middle set first, then needs both halves, which hold it all.
+  const std::vector<std::vector<std::vector<int32_t>>> sets = {
+      {{0, 1, 2, 3, 4, 5, 6}},   // 7 in the middle ... which the two halves also hold
+      {{0, 1, 2, 3, 10, 11}},    // left half + its own
+      {{4, 5, 6, 20, 21, 22}}};  // right half + its own
+  ListCoverSource source(sets);
+  const CoverResult r = greedy_cover(source, 30, 1.0);
+  EXPECT_EQ(r.observable, 13);
+  EXPECT_EQ(r.covered, 13);
+  ASSERT_EQ(r.picks.size(), 2u);
+  EXPECT_EQ(r.dropped, 1);
+  EXPECT_EQ(r.picks[0].group, 1);
+  EXPECT_EQ(r.picks[1].group, 2);
+}
+
+// ---- tour -------------------------------------------------------------------------------------
+
+double brute_force_tour(const std::vector<std::vector<double>>& c) {
+  std::vector<int> rest(c.size() - 1);
+  std::iota(rest.begin(), rest.end(), 1);
+  double best = 1e300;
+  do {
+    std::vector<int> o{0};
+    o.insert(o.end(), rest.begin(), rest.end());
+    best = std::min(best, tour_cost(c, o));
+  } while (std::next_permutation(rest.begin(), rest.end()));
+  return best;
+}
+
+void expect_permutation(const Tour& t, size_t n) {
+  ASSERT_EQ(t.order.size(), n);
+  EXPECT_EQ(t.order[0], 0);
+  std::vector<int> s = t.order;
+  std::sort(s.begin(), s.end());
+  for (size_t i = 0; i < n; ++i) EXPECT_EQ(s[i], static_cast<int>(i));
+}
+
+TEST(OracleTour, ExactAgainstBruteForceAndTheHeuristicClose) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  int heuristic_optimal = 0, trials = 0;
+  for (int n = 2; n <= 8; ++n) {
+    for (int trial = 0; trial < 8; ++trial, ++trials) {
+      // Points in the plane, with a turn cost that makes it asymmetric-free but not Euclidean.
+      std::vector<Eigen::Vector3d> p(static_cast<size_t>(n));
+      for (auto& q : p) q = Eigen::Vector3d(u(rng), u(rng), u(rng) * 0.6);  // z: a yaw in [0, 6)
+      std::vector<std::vector<double>> c(static_cast<size_t>(n), std::vector<double>(static_cast<size_t>(n)));
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          c[static_cast<size_t>(i)][static_cast<size_t>(j)] =
+              (p[static_cast<size_t>(i)] - p[static_cast<size_t>(j)]).head<2>().norm() +
+              std::abs(p[static_cast<size_t>(i)].z() - p[static_cast<size_t>(j)].z());
+      const double best = brute_force_tour(c);
+      const Tour exact = solve_tour(c, 12);
+      expect_permutation(exact, static_cast<size_t>(n));
+      EXPECT_TRUE(exact.exact);
+      EXPECT_NEAR(exact.cost, best, 1e-9) << n << " nodes";
+      EXPECT_NEAR(tour_cost(c, exact.order), exact.cost, 1e-9);
+      const Tour h = solve_tour(c, 0);
+      expect_permutation(h, static_cast<size_t>(n));
+      EXPECT_LE(h.cost, best * 1.15 + 1e-9) << n << " nodes";
+      heuristic_optimal += h.cost <= best + 1e-9;
+    }
+  }
+  EXPECT_GE(heuristic_optimal, trials * 3 / 4) << "of " << trials;
+}
+
+TEST(OracleTour, TheImprovementsRepairWhatNearestNeighbourGetsWrong) {
+  // On a line: nearest neighbour from 0 goes to +1, then -1.1, then -3, then back to +3 (11 m);
+  // the best open tour sweeps one side first (9 m).
+  const std::vector<double> x = {0.0, 1.0, -1.1, 3.0, -3.0};
+  std::vector<std::vector<double>> c(x.size(), std::vector<double>(x.size()));
+  for (size_t i = 0; i < x.size(); ++i)
+    for (size_t j = 0; j < x.size(); ++j) c[i][j] = std::abs(x[i] - x[j]);
+  EXPECT_NEAR(tour_cost(c, {0, 1, 2, 4, 3}), 11.0, 1e-12);
+  const Tour h = solve_tour(c, 0);
+  EXPECT_FALSE(h.exact);
+  EXPECT_NEAR(h.cost, 9.0, 1e-12);
+  EXPECT_NEAR(brute_force_tour(c), 9.0, 1e-12);
+}
+
+// ---- the oracle on a tiny world ----------------------------------------------------------------
+
+// A 4 x 3 x 2.5 m room with a low table in one corner: a few candidates on a coarse lattice.
+SyntheticWorld tiny_world() {
+  std::vector<Box> solids{{Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.2, 0.8, 0.7)}};
+  return SyntheticWorld(0.1, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4.0, 3.0, 2.5)}, solids,
+                        Eigen::Vector3d(2.0, 1.5, 1.2), "tiny");
+}
+
+PlannerConfig tiny_config() {
+  PlannerConfig c = test_config("oracle");
+  c.oracle.spacing = 1.6;
+  c.oracle.height_step = 1.0;
+  c.sampling.z_min = 0.6;
+  c.sampling.z_max = 1.7;
+  c.gain.yaw_bins = 8;  // 45° apart: few sets for the brute force
+  c.oracle.rays_azimuth = 128;
+  c.oracle.rays_elevation = 24;
+  return c;
+}
+
+TEST(Oracle, OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
+  const SyntheticWorld world = tiny_world();
+  const SyntheticTruth truth(world);
+  PlannerConfig c = tiny_config();
+  c.oracle.cover_fraction = 1.0;
+  OracleStrategy oracle(c);
+  oracle.set_truth(&truth);
+  ASSERT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
+  const std::vector<Eigen::Vector3d> cand = oracle.candidates();
+  ASSERT_GE(cand.size(), 4u);
+  ASSERT_LE(cand.size(), 8u);
+  for (const Eigen::Vector3d& p : cand) {
+    EXPECT_FALSE(world.collides(p, c.collision.vehicle_size));
+    EXPECT_GE(p.z(), c.sampling.z_min);
+    EXPECT_LE(p.z(), c.sampling.z_max);
+  }
+  // Every (candidate, yaw) set as a bitset over T's ids.
+  const int64_t ids = oracle.target_ids();
+  ASSERT_GT(ids, 0);
+  ASSERT_LE(ids, 40000);
+  std::vector<std::bitset<40000>> sets;
+  std::bitset<40000> all;
+  for (size_t i = 0; i < cand.size(); ++i) {
+    std::vector<std::bitset<40000>> bins(static_cast<size_t>(c.gain.yaw_bins));
+    for (const MaskedElement& e : oracle.candidate_view(i))
+      for (int b = 0; b < c.gain.yaw_bins; ++b)
+        if (e.members >> b & 1u) bins[static_cast<size_t>(b)].set(static_cast<size_t>(e.element));
+    for (auto& b : bins) {
+      all |= b;
+      sets.push_back(b);
+    }
+  }
+  const OracleSummary& s = oracle.summary();
+  EXPECT_EQ(s.observable, static_cast<int64_t>(all.count()));
+  EXPECT_EQ(s.covered, s.observable);  // fraction 1
+  EXPECT_GT(s.observable_share(), 0.9);
+  // No fewer sets cover it all.
+  const int best = brute_force_cover(sets, all.count(), static_cast<int>(oracle.picks().size()));
+  ASSERT_GT(best, 0);
+  EXPECT_EQ(static_cast<int>(oracle.picks().size()), best);
+  std::bitset<40000> mine;
+  for (const CoverPick& p : oracle.picks()) mine |= sets[static_cast<size_t>(p.group * c.gain.yaw_bins + p.member)];
+  EXPECT_EQ(mine.count(), all.count());
+
+  // The tour: the best order of its viewpoints by brute force, and the viewpoints flown in it.
+  const auto& costs = oracle.tour_costs();
+  ASSERT_EQ(costs.size(), oracle.picks().size() + 1);
+  EXPECT_NEAR(tour_cost(costs, oracle.tour_order()), brute_force_tour(costs), 1e-9);
+  EXPECT_NEAR(s.tour_time, brute_force_tour(costs), 1e-9);
+  EXPECT_TRUE(s.tour_exact);
+  ASSERT_EQ(oracle.tour().size(), oracle.picks().size());
+  for (size_t q = 1; q < oracle.tour_order().size(); ++q) {
+    const CoverPick& p = oracle.picks()[static_cast<size_t>(oracle.tour_order()[q] - 1)];
+    EXPECT_TRUE(oracle.tour()[q - 1].position.isApprox(cand[static_cast<size_t>(p.group)]));
+    EXPECT_NEAR(oracle.tour()[q - 1].yaw, core::wrap_angle(p.member * 2 * M_PI / c.gain.yaw_bins), 1e-12);
+  }
+  // A leg's cost is the travel time of a path on the true free space: at least the straight line.
+  for (size_t i = 1; i < costs.size(); ++i) {
+    const Eigen::Vector3d a = cand[static_cast<size_t>(oracle.picks()[i - 1].group)];
+    EXPECT_GE(costs[0][i] + 1e-9, (a - world.start()).norm() / c.cost.velocity);
+  }
+}
+
+TEST(Oracle, PathsKeepTheClearanceOnTheTrueMapAndGoAroundWalls) {
+  const SyntheticWorld world = SyntheticWorld::two_rooms();
+  const SyntheticTruth truth(world);
+  PlannerConfig c = test_config("oracle");
+  OracleStrategy oracle(c);
+  oracle.set_truth(&truth);
+  ASSERT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
+  // From the first room into the second: through the 1.2 m doorway at y = 2.
+  const Eigen::Vector3d a(1.8, 2.0, 1.2), b(6.5, 1.0, 1.2);
+  const std::vector<Eigen::Vector3d> path = oracle.truth_path(a, b);
+  ASSERT_GE(path.size(), 2u);
+  EXPECT_TRUE(path.front().isApprox(a));
+  EXPECT_TRUE(path.back().isApprox(b));
+  const map::StateGrid full = world.full_map();
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&full);
+  double length = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    length += (path[i] - path[i - 1]).norm();
+    for (int s = 0; s <= 100; ++s) {
+      const Eigen::Vector3d p = path[i - 1] + s / 100.0 * (path[i] - path[i - 1]);
+      EXPECT_GE(checker.esdf(p, 0.6), c.collision.door_clearance - 1e-6) << p.transpose();
+      EXPECT_FALSE(world.collides(p, c.collision.vehicle_size)) << p.transpose();
+    }
+  }
+  EXPECT_GT(length, (b - a).norm());
+  EXPECT_LT(length, (b - a).norm() + 1.5);
+}
+
+TEST(Oracle, WithoutTheTruthItIsDoneAtOnceAndSaysWhy) {
+  const SyntheticWorld world = SyntheticWorld::two_rooms();
+  ExplorationPlanner planner(test_config("oracle"));
+  ExplorationSimOptions o;
+  o.max_time = 5.0;
+  ExplorationSim sim(world, planner, o);
+  const ExplorationSimResult r = sim.run();
+  EXPECT_TRUE(r.done);
+  EXPECT_NE(r.reason.find("--world"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.paths, 0);
+  EXPECT_LT(r.time_s, 1.0);
+}
+
+TEST(Oracle, ClosedLoopMapsWhatItPromised) {
+  const SyntheticWorld world = SyntheticWorld::two_rooms();
+  const SyntheticTruth truth(world);
+  ExplorationPlanner planner(test_config("oracle"));
+  planner.set_truth(&truth);
+  ExplorationSimOptions o;
+  o.max_time = 300.0;
+  o.pixel_step = 2;
+  ExplorationSim sim(world, planner, o);
+  const ExplorationSimResult r = sim.run();
+  const auto& oracle = dynamic_cast<const OracleStrategy&>(planner.strategy());
+  ASSERT_TRUE(oracle.summary().ready) << oracle.summary().error;
+  EXPECT_TRUE(r.done) << r.reason;
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_EQ(oracle.next_viewpoint(), oracle.tour().size());
+  const auto [t_share, observable_share] = oracle.coverage(sim.known());
+  EXPECT_GE(observable_share, 0.99) << r.reason;
+  EXPECT_NEAR(t_share, truth.coverage(sim.known()), 1e-12);
+  EXPECT_NE(r.reason.find("oracle tour flown"), std::string::npos) << r.reason;
+  EXPECT_GE(oracle.summary().cover_share(), 0.99);
+  // It is a tour, not an exploration: one path per viewpoint flown (a few retried at most).
+  EXPECT_LE(r.paths, static_cast<int64_t>(oracle.tour().size()) + 3);
+}
+
+}  // namespace
+}  // namespace semx::planner
