@@ -47,19 +47,21 @@ std::string temp_dir(const std::string& name) {
   return d;
 }
 
-TEST(BenchPlan, DefaultIsThePapersSeventyTwoRunsEnv3First) {
+// The paper's 72 runs plus the FUEL-class baseline and the known-map oracle in every world and seed.
+TEST(BenchPlan, DefaultIsThePapersRunsWithFuelAndOracleEnv3First) {
   const auto runs = plan({});
-  ASSERT_EQ(runs.size(), 72u);
+  ASSERT_EQ(runs.size(), 90u);
   const std::vector<std::string> first = {
       "env3-nbv-s45-seed1 900",          "env3-aep-s45-seed1 900",          "env3-dep-s45-seed1 900",
-      "env3-semantic-dep-s45-seed1 900", "env3-semantic-dep-s30-seed1 900", "env3-semantic-dep-s35-seed1 900",
-      "env3-semantic-dep-s40-seed1 900", "env3-semantic-dep-s50-seed1 900", "env3-nbv-s45-seed2 900"};
+      "env3-semantic-dep-s45-seed1 900", "env3-fuel-s45-seed1 900",         "env3-oracle-s45-seed1 900",
+      "env3-semantic-dep-s30-seed1 900", "env3-semantic-dep-s35-seed1 900", "env3-semantic-dep-s40-seed1 900",
+      "env3-semantic-dep-s50-seed1 900", "env3-nbv-s45-seed2 900"};
   const auto all = names(runs);
-  EXPECT_EQ(std::vector<std::string>(all.begin(), all.begin() + 9), first);
-  EXPECT_EQ(runs[24].name(), "env2-nbv-s45-seed1");
-  EXPECT_EQ(runs[28].name(), "env2-semantic-dep-s25-seed1");
-  EXPECT_EQ(runs[31].name(), "env2-semantic-dep-s40-seed1");
-  EXPECT_EQ(runs[48].time_limit, "300");
+  EXPECT_EQ(std::vector<std::string>(all.begin(), all.begin() + 11), first);
+  EXPECT_EQ(runs[30].name(), "env2-nbv-s45-seed1");
+  EXPECT_EQ(runs[36].name(), "env2-semantic-dep-s25-seed1");
+  EXPECT_EQ(runs[39].name(), "env2-semantic-dep-s40-seed1");
+  EXPECT_EQ(runs[60].time_limit, "300");
   EXPECT_EQ(runs.back().name(), "env1-semantic-dep-s40-seed3");
 }
 
@@ -158,7 +160,8 @@ TEST(BenchPlan, DryRunText) {
 TEST(BenchPlan, QuickIsEnv1OneSeedNoSweepAt120s) {
   EXPECT_EQ(names(plan({"--quick"})),
             (std::vector<std::string>{"env1-nbv-s45-seed1 120", "env1-aep-s45-seed1 120",
-                                      "env1-dep-s45-seed1 120", "env1-semantic-dep-s45-seed1 120"}));
+                                      "env1-dep-s45-seed1 120", "env1-semantic-dep-s45-seed1 120",
+                                      "env1-fuel-s45-seed1 120", "env1-oracle-s45-seed1 120"}));
 }
 
 TEST(BenchPlan, FlagsApplyInOrder) {

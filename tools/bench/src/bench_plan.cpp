@@ -18,7 +18,7 @@ namespace {
 
 // "oracle" is the known-map reference (it reads the world's ground truth): never in the default
 // list, which is the paper's comparison; the report divides the others' times by its own.
-const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "oracle"};
+const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle"};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -310,7 +310,7 @@ std::string bench_help() {
 The paper's experiment, in LOCKSTEP (deterministic per seed): for every world and seeds 1..N,
 (a) the sampling-density sweep of Table II for semantic-dep (--sweep LIST for every world; the
 default, "paper", is the table's rows: env1 and env2 at 25,30,35,40,45, env3 at 30,35,40,45,50,
-a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep) at
+a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep,fuel,oracle) at
 --samples (default 45); --planners may add oracle, the known-map reference that reads the world's
 ground truth (the report divides every planner's times by its own). Each run is ./semx demo's process set writing a run folder under
 DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has the metrics of a run

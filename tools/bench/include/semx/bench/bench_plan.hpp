@@ -16,7 +16,7 @@ namespace semx::bench {
 // overrides an earlier one (`--quick --worlds env2` runs env2, `--worlds env2 --quick` env1).
 struct BenchOptions {
   std::string worlds = "env1,env2,env3";
-  std::string planners = "nbv,aep,dep,semantic-dep";
+  std::string planners = "nbv,aep,dep,semantic-dep,fuel,oracle";
   std::string seeds = "3";
   std::string sweep = "paper";  // a comma list, "" for none, or "paper": Table II's rows per world
   std::string samples = "45";   // the density of the planner comparison
