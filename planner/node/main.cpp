@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     flags.add_to(p);
     p.option("config", "FILE", "planner YAML (default: built-in defaults, docs/planner.md)", &config_file)
         .repeated("set", "KEY=VALUE", "override one config key, e.g. --set gain.min_gain=30", &overrides)
-        .option("planner", "NAME", "semantic-dep (default), dep, nbv or aep (= --set planner=NAME)", &planner)
+        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep or fuel (= --set planner=NAME)", &planner)
         .option("seed", "N", "random seed (= --set seed=N)", &seed)
         .option("samples", "N", "sampling density (= --set sampling.samples=N)", &samples);
     if (!p.parse(argc, argv)) return 0;

@@ -16,7 +16,7 @@ using runtime::ArgError;
 
 namespace {
 
-const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep"};
+const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel"};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -301,7 +301,7 @@ std::string bench_help() {
 The paper's experiment, in LOCKSTEP (deterministic per seed): for every world and seeds 1..N,
 (a) the sampling-density sweep of Table II for semantic-dep (--sweep LIST for every world; the
 default, "paper", is the table's rows: env1 and env2 at 25,30,35,40,45, env3 at 30,35,40,45,50,
-a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep) at
+a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep; fuel too) at
 --samples (default 45). Each run is ./semx demo's process set writing a run folder under
 DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has metrics.json is not
 run again, so an interrupted bench continues where it stopped. At the end semx-bench-report
