@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     p.option("config", "FILE", "planner YAML (default: built-in defaults, docs/planner.md)", &config_file)
         .repeated("set", "KEY=VALUE", "override one config key, e.g. --set gain.min_gain=30", &overrides)
         .option("planner", "NAME",
-                "semantic-dep (default), dep, nbv, aep, or oracle: the known-map reference, which reads the "
+                "semantic-dep (default), dep, nbv, aep, fuel, or oracle: the known-map reference, which reads the "
                 "world's ground truth (--world) and cheats (= --set planner=NAME)",
                 &planner)
         .option("world", "FILE",

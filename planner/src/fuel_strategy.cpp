@@ -454,6 +454,11 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       ctx.counters->search_settled += expanded;
     }
     ctx.counters->connect_ms += pw.ms();
+    if (std::getenv("SEMX_FUEL_DEBUG"))
+      std::fprintf(stderr, "path t=%.2f from (%.2f %.2f %.2f) to (%.2f %.2f %.2f): %s, guide %zu, expanded %lld, %zu wp\n",
+                   1e-6 * ctx.pose.utime, vehicle_.x(), vehicle_.y(), vehicle_.z(), goal_view.position.x(),
+                   goal_view.position.y(), goal_view.position.z(), found ? "found" : "none", guide.size(),
+                   static_cast<long long>(expanded), waypoints.size());
     if (!found) {
       blacklist_.push_back({goal_view.position, ctx.cycle + config_.loop.blacklist_cycles});
       *reason = "no path to the tour's next viewpoint";

@@ -233,7 +233,10 @@ uint8_t GridSearch::passable(Lattice& l, int64_t i, const Eigen::Vector3d& sourc
   // The box check is dear and a cell is asked about by each of its neighbours: once per search.
   const auto it = escape_cache_.find(i);
   if (it != escape_cache_.end()) return it->second;
-  const uint8_t e = grid_->state(p) == VoxelState::kFree && checker_.vehicle_free(p) ? kEscape : kBlocked;
+  // Unknown voxels pass too, as on root_edge_free's centre line near the root: the mapper leaves
+  // the camera's first half metre unknown, so a vehicle that has not moved yet sits in unknown
+  // space (the process set's env2 run never left its start before this).
+  const uint8_t e = grid_->state(p) != VoxelState::kOccupied && checker_.vehicle_free(p) ? kEscape : kBlocked;
   escape_cache_.emplace(i, e);
   return e;
 }
@@ -596,11 +599,14 @@ bool GridSearch::body_clear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) 
   // edge_free lets the bare body box touch a voxel's face where a doorway's clearance is allowed:
   // rounding a door leaf's end diagonally at an ESDF of 0.37 m, the box's corner met the leaf's
   // corner voxel (env3, seed 1, counted as a collision by the closed box of the closed loop).
+  // Occupied voxels only: unknown ones keep edge_free's clearance already, and the grown box
+  // against them refused every path from the process set's start, among unknown voxels the
+  // camera has not seen.
   const Eigen::Vector3d half = 0.5 * collision_.vehicle_size + Eigen::Vector3d::Constant(kBodyMargin);
   const double length = (b - a).norm();
   const int n = std::max(1, static_cast<int>(std::ceil(length / kBodyStep)));
   for (int k = 0; k <= n; ++k)
-    if (!checker_.box_free(a + (static_cast<double>(k) / n) * (b - a), half, true)) return false;
+    if (!checker_.box_free(a + (static_cast<double>(k) / n) * (b - a), half, false)) return false;
   return true;
 }
 

@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
-        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep, oracle (reads the world's truth)",
+        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep, fuel, oracle (reads the world's truth)",
                 &planner_name)
         .option("samples", "N", "sampling density (default: config, 45)", &samples)
         .option("seed", "N", "first seed (runs use seed, seed+1, ...)", &seed)

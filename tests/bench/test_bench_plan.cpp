@@ -210,6 +210,7 @@ TEST(BenchPlan, FlagErrorsNameTheFlag) {
   EXPECT_EQ(error_of({"--samples", "-1"}), "--samples '-1': expected a positive integer");
   EXPECT_EQ(error_of({"--jobs", "0"}), "--jobs '0': expected a positive integer");
   EXPECT_EQ(error_of({"--planners", "dep,foo"}), "--planners: unknown planner 'foo'");
+  EXPECT_EQ(error_of({"--planners", "nbv,aep,dep,semantic-dep,fuel", "--dry-run"}), "");  // every planner known
   EXPECT_EQ(error_of({"--sweep", "30,x"}), "--sweep: 'x' is not a positive integer (or paper)");
   EXPECT_EQ(error_of({"--sweep", "0"}), "--sweep: '0' is not a positive integer (or paper)");
   EXPECT_EQ(error_of({"--worlds", "env1,/nonexistent/w.yaml"}),

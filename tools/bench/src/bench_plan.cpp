@@ -16,8 +16,8 @@ using runtime::ArgError;
 
 namespace {
 
-// "oracle" is the known-map reference (it reads the world's ground truth): never in the default
-// list, which is the paper's comparison; the report divides the others' times by its own.
+// "oracle" is the known-map reference (it reads the world's ground truth); the report divides
+// the others' times by its own.
 const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle"};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -311,8 +311,8 @@ The paper's experiment, in LOCKSTEP (deterministic per seed): for every world an
 (a) the sampling-density sweep of Table II for semantic-dep (--sweep LIST for every world; the
 default, "paper", is the table's rows: env1 and env2 at 25,30,35,40,45, env3 at 30,35,40,45,50,
 a world file at 25,30,35,40,45,50) and (b) the planner comparison of Table III (--planners, default nbv,aep,dep,semantic-dep,fuel,oracle) at
---samples (default 45); --planners may add oracle, the known-map reference that reads the world's
-ground truth (the report divides every planner's times by its own). Each run is ./semx demo's process set writing a run folder under
+--samples (default 45); oracle is the known-map reference that reads the world's ground truth (the
+report divides every planner's times by its own), fuel the FUEL-class baseline. Each run is ./semx demo's process set writing a run folder under
 DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has the metrics of a run
 that ended (DONE, time limit) is not run again, so an interrupted bench continues where it
 stopped; one that was stopped before its end runs again, its old folder moved to

@@ -14,7 +14,7 @@
 // On both, a step into a cell whose ESDF is below passage_clearance costs (1 + low_penalty) times
 // its length, so paths keep to the middle of rooms and cross doorways, not corridors along walls;
 // diagonal steps need every cell they cut across passable. Near the search's source (within
-// collision.root_escape_radius) a cell is passable when it is known free and the bare body box
+// collision.root_escape_radius) a cell is passable when it is not occupied and the bare body box
 // there touches no occupied voxel: root_edge_free's escape rule, so a vehicle whose surroundings
 // are not all mapped (always at the start) can leave.
 //
@@ -70,7 +70,7 @@ class GridSearch {
   bool shorten(const std::vector<Eigen::Vector3d>& path, std::vector<Eigen::Vector3d>& out, size_t first = 0) const;
 
   int step() const { return coarse_.stride; }
-  // The body box with a small margin overlaps no occupied or unknown voxel anywhere on a-b.
+  // The body box with a small margin overlaps no occupied voxel anywhere on a-b.
   bool body_clear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
  private:

@@ -1,0 +1,493 @@
+// FUEL (fuel_strategy.hpp) and its parts: the incremental frontier clusters and their splits, the
+// open asymmetric tour against brute force, the grid search through a doorway, viewpoints that
+// face a frontier, and whole explorations of the synthetic worlds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "planner_test_util.hpp"
+#include "semx/core/angles.hpp"
+#include "semx/core/random.hpp"
+#include "semx/fixtures/exploration_sim.hpp"
+#include "semx/planner/cluster_viewpoints.hpp"
+#include "semx/planner/collision_checker.hpp"
+#include "semx/planner/exploration_planner.hpp"
+#include "semx/planner/frontier_clusters.hpp"
+#include "semx/planner/frontier_tracker.hpp"
+#include "semx/planner/fuel_strategy.hpp"
+#include "semx/planner/grid_search.hpp"
+#include "semx/planner/tour_solver.hpp"
+
+namespace semx::planner {
+namespace {
+
+using map::VoxelKey;
+using map::VoxelState;
+
+// ---------------------------------------------------------------- frontier clusters
+
+std::vector<VoxelKey> patch(int x0, int x1, int y0, int y1, int z) {
+  std::vector<VoxelKey> v;
+  for (int x = x0; x <= x1; ++x)
+    for (int y = y0; y <= y1; ++y) v.push_back({x, y, z});
+  return v;
+}
+
+struct Eligible {
+  std::set<VoxelKey> keys;
+  FrontierClusters::Eligible fn() const {
+    return [this](const VoxelKey& k) { return keys.count(k) != 0; };
+  }
+};
+
+TEST(FrontierClusters, TwoSeparatePatchesAreTwoClusters) {
+  Eligible e;
+  for (const VoxelKey& k : patch(0, 4, 0, 4, 10)) e.keys.insert(k);
+  for (const VoxelKey& k : patch(20, 24, 0, 4, 10)) e.keys.insert(k);
+  // Three voxels apart from both: a group below min_voxels is no cluster.
+  for (const VoxelKey& k : patch(40, 42, 0, 0, 10)) e.keys.insert(k);
+  FrontierClusters fc(0.1, 5, 2.0);
+  const auto changes = fc.rebuild({e.keys.begin(), e.keys.end()}, e.fn());
+  ASSERT_EQ(fc.clusters().size(), 2u);
+  EXPECT_EQ(changes.added.size(), 2u);
+  std::vector<double> xs;
+  for (const auto& [id, c] : fc.clusters()) {
+    EXPECT_EQ(c.voxels.size(), 25u);
+    EXPECT_NEAR(c.mean.y(), 0.25, 1e-9);
+    xs.push_back(c.mean.x());
+  }
+  std::sort(xs.begin(), xs.end());
+  EXPECT_NEAR(xs[0], 0.25, 1e-9);
+  EXPECT_NEAR(xs[1], 2.25, 1e-9);
+  EXPECT_EQ(fc.owner({41, 0, 10}), -1);
+}
+
+TEST(FrontierClusters, DiagonalNeighboursJoinOneCluster) {
+  // 26-connectivity (FUEL's allNeighbors): a staircase touching only at edges is one cluster.
+  Eligible e;
+  for (int i = 0; i < 10; ++i) e.keys.insert({i, i, i});
+  FrontierClusters fc(0.1, 5, 2.0);
+  fc.rebuild({e.keys.begin(), e.keys.end()}, e.fn());
+  EXPECT_EQ(fc.clusters().size(), 1u);
+}
+
+TEST(FrontierClusters, ALongPatchIsSplitAlongItsAxisIntoPiecesWithinTheRadius) {
+  // 6 m along x, 0.3 m across: cut across x until every piece is within 1 m of its mean.
+  Eligible e;
+  for (const VoxelKey& k : patch(0, 59, 0, 2, 10)) e.keys.insert(k);
+  FrontierClusters fc(0.1, 5, 1.0);
+  fc.rebuild({e.keys.begin(), e.keys.end()}, e.fn());
+  ASSERT_GE(fc.clusters().size(), 4u);
+  size_t total = 0;
+  std::vector<std::pair<int, int>> spans;
+  for (const auto& [id, c] : fc.clusters()) {
+    total += c.voxels.size();
+    int lo = 1000, hi = -1000;
+    std::set<int> ys;
+    for (const VoxelKey& k : c.voxels) {
+      const Eigen::Vector2d p((k.x + 0.5) * 0.1, (k.y + 0.5) * 0.1);
+      EXPECT_LE((p - c.mean.head<2>()).norm(), 1.0 + 1e-9);
+      lo = std::min(lo, k.x);
+      hi = std::max(hi, k.x);
+      ys.insert(k.y);
+    }
+    EXPECT_EQ(ys.size(), 3u) << "cut along the principal axis, not across it";
+    spans.emplace_back(lo, hi);
+  }
+  EXPECT_EQ(total, 180u);
+  // The pieces are consecutive intervals of x.
+  std::sort(spans.begin(), spans.end());
+  for (size_t i = 1; i < spans.size(); ++i) EXPECT_EQ(spans[i].first, spans[i - 1].second + 1);
+  EXPECT_EQ(spans.front().first, 0);
+  EXPECT_EQ(spans.back().second, 59);
+}
+
+TEST(FrontierClusters, ADiagonalPatchIsCutAcrossItsDiagonal) {
+  // The principal axis, not a coordinate axis: a band along x = y splits into pieces ordered
+  // along the diagonal.
+  Eligible e;
+  for (int i = 0; i < 50; ++i)
+    for (int d = 0; d < 2; ++d) e.keys.insert({i + d, i, 10});
+  FrontierClusters fc(0.1, 5, 1.0);
+  fc.rebuild({e.keys.begin(), e.keys.end()}, e.fn());
+  ASSERT_GE(fc.clusters().size(), 3u);
+  for (const auto& [id, c] : fc.clusters()) {
+    int lo = 1000, hi = -1000;
+    for (const VoxelKey& k : c.voxels) lo = std::min(lo, k.y), hi = std::max(hi, k.y);
+    EXPECT_LE(hi - lo, 15) << "a piece spans a stretch of the diagonal";
+  }
+}
+
+TEST(FrontierClusters, AnUpdateRegrowsOnlyTheClusterThatLostAVoxel) {
+  Eligible e;
+  for (const VoxelKey& k : patch(0, 4, 0, 4, 10)) e.keys.insert(k);
+  for (const VoxelKey& k : patch(20, 24, 0, 4, 10)) e.keys.insert(k);
+  FrontierClusters fc(0.1, 5, 2.0);
+  fc.rebuild({e.keys.begin(), e.keys.end()}, e.fn());
+  const int64_t a = fc.owner({0, 0, 10}), b = fc.owner({20, 0, 10});
+  ASSERT_GE(a, 0);
+  ASSERT_GE(b, 0);
+  e.keys.erase({2, 2, 10});  // observed: no longer frontier
+  const auto changes = fc.update({{2, 2, 10}}, e.fn());
+  EXPECT_EQ(changes.removed, std::vector<int64_t>{a});
+  ASSERT_EQ(changes.added.size(), 1u);
+  EXPECT_EQ(fc.owner({20, 0, 10}), b) << "the untouched cluster keeps its id";
+  const FrontierClusters::Cluster* c = fc.find(changes.added[0]);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->voxels.size(), 24u);
+  EXPECT_EQ(fc.owner({2, 2, 10}), -1);
+  // A dirty voxel that changed nothing changes nothing.
+  EXPECT_TRUE(fc.update({{20, 0, 10}}, e.fn()).added.empty());
+  EXPECT_EQ(fc.owner({20, 0, 10}), b);
+}
+
+// ---------------------------------------------------------------- tour
+
+TourProblem random_problem(int n, core::SplitMixRng& rng) {
+  TourProblem p;
+  p.n = n;
+  p.cost.assign(static_cast<size_t>(n * n), 0.0);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (i != j) p.cost[static_cast<size_t>(i * n + j)] = rng.uniform(1.0, 10.0);
+  return p;
+}
+
+double brute_force(const TourProblem& p, int first = -1) {
+  std::vector<int> order;
+  for (int i = 1; i < p.n; ++i) order.push_back(i);
+  double best = std::numeric_limits<double>::infinity();
+  do {
+    if (first >= 1 && order.front() != first) continue;
+    best = std::min(best, open_path_cost(p, order));
+  } while (std::next_permutation(order.begin(), order.end()));
+  return best;
+}
+
+bool is_permutation_of_sites(const std::vector<int>& order, int n) {
+  std::vector<int> s = order;
+  std::sort(s.begin(), s.end());
+  for (int i = 1; i < n; ++i)
+    if (static_cast<int>(s.size()) < i || s[static_cast<size_t>(i - 1)] != i) return false;
+  return static_cast<int>(s.size()) == n - 1;
+}
+
+TEST(TourSolver, ExactMatchesBruteForceOnAsymmetricCosts) {
+  core::SplitMixRng rng(7);
+  for (int n = 2; n <= 8; ++n) {
+    for (int trial = 0; trial < 5; ++trial) {
+      const TourProblem p = random_problem(n, rng);
+      const Tour t = exact_open_tour(p);
+      ASSERT_TRUE(is_permutation_of_sites(t.order, n));
+      EXPECT_NEAR(t.cost, open_path_cost(p, t.order), 1e-9);
+      EXPECT_NEAR(t.cost, brute_force(p), 1e-9) << "n " << n;
+      const Tour f = exact_open_tour(p, n - 1);
+      ASSERT_FALSE(f.order.empty());
+      EXPECT_EQ(f.order.front(), n - 1);
+      EXPECT_NEAR(f.cost, brute_force(p, n - 1), 1e-9);
+    }
+  }
+}
+
+TEST(TourSolver, TheDirectionOfTheTourMatters) {
+  // 0 -> 1 -> 2 -> 3 is cheap one way only (a slope, a turn): the reverse costs 10 per leg.
+  TourProblem p;
+  p.n = 4;
+  p.cost.assign(16, 10.0);
+  p.cost[0 * 4 + 1] = 1;
+  p.cost[1 * 4 + 2] = 1;
+  p.cost[2 * 4 + 3] = 1;
+  p.cost[0 * 4 + 3] = 2;  // cheaper first leg, but the way back from 3 is dear
+  const Tour t = solve_open_tour(p, 11);
+  EXPECT_EQ(t.order, (std::vector<int>{1, 2, 3}));
+  EXPECT_DOUBLE_EQ(t.cost, 3.0);
+  const Tour h = heuristic_open_tour(p);
+  EXPECT_DOUBLE_EQ(h.cost, 3.0);
+}
+
+TEST(TourSolver, ReturnsToTheStartAreFree) {
+  // Column 0 (back to the vehicle) never counts, however dear.
+  core::SplitMixRng rng(3);
+  TourProblem p = random_problem(6, rng);
+  const Tour a = exact_open_tour(p);
+  for (int i = 1; i < 6; ++i) p.cost[static_cast<size_t>(i * 6)] = 1e6;
+  const Tour b = exact_open_tour(p);
+  EXPECT_EQ(a.order, b.order);
+  EXPECT_DOUBLE_EQ(a.cost, b.cost);
+}
+
+TEST(TourSolver, TheHeuristicIsAValidTourCloseToTheOptimum) {
+  core::SplitMixRng rng(11);
+  double worst = 1.0, sum = 0.0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const TourProblem p = random_problem(9, rng);
+    const Tour h = heuristic_open_tour(p);
+    ASSERT_TRUE(is_permutation_of_sites(h.order, 9));
+    EXPECT_NEAR(h.cost, open_path_cost(p, h.order), 1e-9);
+    const double opt = exact_open_tour(p).cost;
+    EXPECT_GE(h.cost, opt - 1e-9);
+    worst = std::max(worst, h.cost / opt);
+    sum += h.cost / opt;
+    const Tour f = heuristic_open_tour(p, 4);
+    EXPECT_EQ(f.order.front(), 4);
+  }
+  // Nearest neighbour alone is often 30-50 % off on random asymmetric costs; six starts of 2-opt
+  // and Or-opt bring it within a few per cent on the mean.
+  EXPECT_LT(worst, 1.15);
+  EXPECT_LT(sum / 20, 1.05);
+  // Above exact_max the heuristic answers.
+  const TourProblem big = random_problem(14, rng);
+  EXPECT_FALSE(solve_open_tour(big, 11).exact);
+  EXPECT_TRUE(solve_open_tour(random_problem(6, rng), 11).exact);
+}
+
+// ---------------------------------------------------------------- grid search
+
+// Two 4 x 4 x 2.5 m rooms, fully known, joined by a 1.0 m doorway in the wall at x = 4.
+map::StateGrid two_known_rooms() {
+  map::StateGrid g(0.1);
+  fill_m(g, {-0.2, -0.2, -0.2}, {8.2, 4.2, 2.7}, VoxelState::kOccupied);
+  fill_m(g, {0.0, 0.0, 0.0}, {8.0, 4.0, 2.5}, VoxelState::kFree);
+  fill_m(g, {3.9, 0.0, 0.0}, {4.1, 4.0, 2.5}, VoxelState::kOccupied);
+  fill_m(g, {3.9, 1.5, 0.0}, {4.1, 2.5, 2.1}, VoxelState::kFree);
+  return g;
+}
+
+TEST(GridSearch, FindsAPathThroughADoorwayThatPassesTheChecks) {
+  const map::StateGrid g = two_known_rooms();
+  const PlannerConfig c = test_config("fuel");
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
+  s.set_grid(&g);
+  const Eigen::Vector3d a(1.5, 0.8, 1.2), b(6.5, 0.8, 1.2);
+  const GridSearch::Result r = s.distances(a, true, {b, Eigen::Vector3d(4.0, 0.5, 1.2)}, 1000000, true);
+  // Around through the doorway (1.2 m off the straight line each way), not through the wall.
+  EXPECT_GT(r.distance[0], (b - a).norm() + 0.5);
+  EXPECT_LT(r.distance[0], (b - a).norm() + 3.0);
+  EXPECT_FALSE(r.distance[1] < 1e9) << "inside the wall: not reached";
+  std::vector<Eigen::Vector3d> path;
+  ASSERT_TRUE(s.find_path(a, b, s.tree_path(b), 1000000, path));
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_EQ(path.front(), a);
+  EXPECT_EQ(path.back(), b);
+  for (size_t i = 1; i < path.size(); ++i) {
+    EXPECT_TRUE(checker.edge_free(path[i - 1], path[i])) << "segment " << i;
+    EXPECT_TRUE(s.body_clear(path[i - 1], path[i])) << "segment " << i;
+    // The wall plane is crossed inside the doorway only.
+    const Eigen::Vector3d& p = path[i - 1];
+    const Eigen::Vector3d& q = path[i];
+    if ((p.x() - 4.0) * (q.x() - 4.0) < 0) {
+      const double t = (4.0 - p.x()) / (q.x() - p.x());
+      const Eigen::Vector3d x = p + t * (q - p);
+      EXPECT_GT(x.y(), 1.5);
+      EXPECT_LT(x.y(), 2.5);
+    }
+  }
+}
+
+TEST(GridSearch, ChangesNearACellAreSeenByTheNextSearch) {
+  // Close the doorway: the next search finds no way, the cache notwithstanding.
+  map::StateGrid g = two_known_rooms();
+  const PlannerConfig c = test_config("fuel");
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
+  s.set_grid(&g);
+  const Eigen::Vector3d a(1.5, 0.8, 1.2), b(6.5, 0.8, 1.2);
+  ASSERT_TRUE(s.distances(a, true, {b}, 1000000, false).distance[0] < 1e9);
+  std::vector<map::VoxelChange> changes;
+  for (int32_t z = 0; z < 25; ++z)
+    for (int32_t y = 15; y < 25; ++y)
+      for (int32_t x = 39; x <= 40; ++x) {
+        g.set_state({x, y, z}, VoxelState::kOccupied);
+        changes.push_back({{x, y, z}, VoxelState::kOccupied});
+      }
+  checker.note_changes(changes);
+  s.note_changes(changes);
+  EXPECT_FALSE(s.distances(a, true, {b}, 1000000, false).distance[0] < 1e9);
+  std::vector<Eigen::Vector3d> path;
+  EXPECT_FALSE(s.find_path(a, b, {}, 1000000, path));
+}
+
+// ---------------------------------------------------------------- viewpoints
+
+map::StateGrid corridor() {
+  map::StateGrid g(0.1);
+  SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2})
+      .reveal(g, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.0, 4.2, 2.7)});
+  return g;
+}
+
+TEST(Viewpoints, FaceTheFrontierFromFreeSpaceWithTheClearance) {
+  const map::StateGrid g = corridor();  // the frontier is the plane x = 6.0..6.1
+  const PlannerConfig c = test_config("fuel");
+  FrontierTracker tracker;
+  tracker.reset(g);
+  FrontierClusters fc(0.1, c.fuel.min_cluster_voxels, c.fuel.split_radius);
+  const auto& all = tracker.voxels();
+  fc.rebuild({all.begin(), all.end()}, [&](const VoxelKey& k) { return tracker.contains(k) && k.z >= 4; });
+  ASSERT_FALSE(fc.clusters().empty());
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GainEvaluator gains(c.gain);
+  ViewpointSampler sampler(c, checker, gains);
+  int with_views = 0;
+  for (const auto& [id, cl] : fc.clusters()) {
+    const std::vector<Viewpoint> views = sampler.sample(g, cl, nullptr);
+    if (views.empty()) continue;
+    ++with_views;
+    for (size_t i = 0; i < views.size(); ++i) {
+      const Viewpoint& v = views[i];
+      EXPECT_TRUE(checker.node_free(v.position));
+      EXPECT_LT(v.position.x(), 6.0) << "on the known side";
+      EXPECT_GE(v.coverage, c.fuel.min_coverage);
+      if (i > 0) {
+        EXPECT_LE(v.coverage, views[i - 1].coverage) << "best first";
+      }
+    }
+    // The best one looks at its cluster: the cluster's mean lies within the camera's 90°.
+    const Eigen::Vector3d d = cl.mean - views[0].position;
+    EXPECT_LT(core::yaw_distance(views[0].yaw, std::atan2(d.y(), d.x())), 0.5 * c.gain.horizontal_fov() + 0.1);
+  }
+  EXPECT_GT(with_views, 0);
+}
+
+TEST(Viewpoints, TheCameraDoesNotSeeThroughWalls) {
+  // A frontier voxel behind a wall is not seen from the other side, one in the open is.
+  map::StateGrid g(0.1);
+  fill_m(g, {0.0, 0.0, 0.0}, {4.0, 4.0, 2.5}, VoxelState::kFree);
+  fill_m(g, {2.0, 0.0, 0.0}, {2.1, 4.0, 2.5}, VoxelState::kOccupied);
+  const PlannerConfig c = test_config("fuel");
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GainEvaluator gains(c.gain);
+  ViewpointSampler sampler(c, checker, gains);
+  const VoxelKey behind = g.keys().key(Eigen::Vector3d(3.0, 2.0, 1.2));
+  const VoxelKey open = g.keys().key(Eigen::Vector3d(1.5, 2.0, 1.2));
+  const Eigen::Vector3d from(0.5, 2.0, 1.2);
+  EXPECT_EQ(sampler.view_from(g, {behind}, 1.0, from, nullptr).coverage, 0.0);
+  EXPECT_EQ(sampler.view_from(g, {open}, 1.0, from, nullptr).coverage, 1.0);
+}
+
+// ---------------------------------------------------------------- yaws
+
+TEST(Fuel, YawsTurnTowardTheGoalAsFastAsTheRateAllows) {
+  const std::vector<Eigen::Vector3d> w = {{0, 0, 1}, {0.5, 0, 1}, {1.0, 0, 1}, {4.0, 0, 1}};
+  const std::vector<double> y = turn_early_yaws(w, 0.0, 2.0, 1.0, 1.0);
+  ASSERT_EQ(y.size(), 4u);
+  EXPECT_DOUBLE_EQ(y[0], 0.0);
+  EXPECT_NEAR(y[1], 0.5, 1e-12);  // 0.5 m at 1 m/s: 0.5 rad at 1 rad/s
+  EXPECT_NEAR(y[2], 1.0, 1e-12);
+  EXPECT_NEAR(y[3], 2.0, 1e-12);
+  // The shorter way round: from 3 rad to -2 rad is +1.28 rad through pi.
+  const std::vector<double> z = turn_early_yaws(w, 3.0, -2.0, 1.0, 1.0);
+  EXPECT_NEAR(core::wrap_angle(z[1] - 3.5), 0.0, 1e-12);
+  EXPECT_NEAR(z[3], -2.0, 1e-12);
+}
+
+// ---------------------------------------------------------------- whole explorations
+
+// Every released path: segments pass the check the main loop uses (root rule from the
+// vehicle), the goal is where the vehicle can hover, and the waypoints between keep at least a
+// doorway's clearance.
+struct FuelAudit {
+  const map::StateGrid* grid = nullptr;
+  CollisionChecker checker{CollisionConfig{}};
+  int paths = 0, bad = 0;
+
+  void check(const PlannedPath& path) {
+    ++paths;
+    checker.set_grid(grid);
+    EXPECT_EQ(path.waypoints.size(), path.yaws.size());
+    bool ok = checker.node_free(path.waypoints.back()) || path.waypoints.size() == 1;
+    for (size_t i = 1; i < path.waypoints.size(); ++i) {
+      ok &= i == 1 ? checker.root_edge_free(path.waypoints[0], path.waypoints[1])
+                   : checker.edge_free(path.waypoints[i - 1], path.waypoints[i]);
+      if (i + 1 < path.waypoints.size()) ok &= checker.passage_free(path.waypoints[i]);
+    }
+    if (!ok) ++bad;
+    EXPECT_TRUE(ok) << "path " << path.plan_id;
+  }
+};
+
+ExplorationSimResult explore(const SyntheticWorld& w, double max_time, FuelAudit* audit, int64_t seed = 1) {
+  PlannerConfig c = test_config("fuel");
+  c.seed = seed;
+  ExplorationPlanner p(c);
+  ExplorationSimOptions o;
+  o.max_time = max_time;
+  ExplorationSim sim(w, p, o);
+  if (audit) audit->grid = &sim.known();
+  return sim.run([&](double, const ExplorationPlanner::Output& out) {
+    if (out.path && audit) audit->check(*out.path);
+  });
+}
+
+TEST(Fuel, ExploresTwoRoomsToDoneWithoutCollisions) {
+  FuelAudit audit;
+  const ExplorationSimResult r = explore(SyntheticWorld::two_rooms(), 200, &audit);
+  EXPECT_TRUE(r.done) << r.reason;
+  EXPECT_GT(r.coverage, 0.97);
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_GT(audit.paths, 3);
+  EXPECT_EQ(audit.bad, 0);
+  EXPECT_NE(r.reason.find("no frontier cluster with a reachable viewpoint"), std::string::npos) << r.reason;
+}
+
+TEST(Fuel, ExploresTheApartmentToDone) {
+  // Six rooms off a corridor (env3's size): every room visited, 95 % well before the end.
+  FuelAudit audit;
+  const ExplorationSimResult r = explore(SyntheticWorld::apartment(), 400, &audit);
+  EXPECT_TRUE(r.done) << r.reason;
+  EXPECT_GT(r.coverage, 0.97);
+  EXPECT_EQ(r.collisions, 0);
+  EXPECT_EQ(audit.bad, 0);
+  EXPECT_GT(r.time_95, 0);
+  EXPECT_LT(r.time_95, r.time_s);
+}
+
+TEST(Fuel, DeclaresDoneOnAFullyKnownMap) {
+  const SyntheticWorld w = SyntheticWorld::two_rooms();
+  map::StateGrid g = w.full_map();
+  ExplorationPlanner p(test_config("fuel"));
+  p.set_map(&g);
+  VehiclePose pose;
+  pose.position = w.start();
+  p.set_pose(pose);
+  for (int64_t t = 0; t < 5000000 && p.state() != PlannerState::kDone; t += 50000) {
+    pose.utime = t;
+    p.set_pose(pose);
+    p.tick(t);
+  }
+  EXPECT_EQ(p.state(), PlannerState::kDone);
+  EXPECT_NE(p.last_status().reason.find("no frontier cluster"), std::string::npos) << p.last_status().reason;
+}
+
+TEST(Fuel, SameSeedSameFlightAndTheSeedMoves) {
+  auto fly = [](int64_t seed) {
+    PlannerConfig c = test_config("fuel");
+    c.seed = seed;
+    ExplorationPlanner p(c);
+    ExplorationSimOptions o;
+    o.max_time = 30;
+    const SyntheticWorld w = SyntheticWorld::two_rooms();
+    ExplorationSim sim(w, p, o);
+    return sim.run().released;
+  };
+  const auto a = fly(5), b = fly(5), other = fly(6);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].waypoints, b[i].waypoints);
+    EXPECT_EQ(a[i].yaws, b[i].yaws);
+  }
+  bool differs = a.size() != other.size();
+  for (size_t i = 0; !differs && i < a.size(); ++i) differs = a[i].waypoints != other[i].waypoints;
+  EXPECT_TRUE(differs) << "the seed sets the viewpoint rings' phase";
+}
+
+}  // namespace
+}  // namespace semx::planner
