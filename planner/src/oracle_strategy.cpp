@@ -585,8 +585,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   auto yaw_of = [&](int b) { return b * 2.0 * M_PI / bins; };
 
   // 3. The first pass: from the vehicle, the view (candidate, yaw) that shows the most T voxels
-  // not yet shown per second of travel (travel_time() of the path length on the true free space
-  // and the turn), again and again, until oracle.first_pass of the observable part is shown. What
+  // not yet shown per (second of travel)^time_exponent (travel_time() of the path length on the
+  // true free space and the turn), again and again, until oracle.first_pass of the observable part is shown. What
   // a view shows only shrinks as more is shown, so a ratio computed earlier is an upper bound:
   // only the views whose bound comes first are counted again (from the cache).
   std::vector<uint8_t> shown(m.targets.size(), 0);
@@ -601,9 +601,12 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     std::vector<int> counted(groups, -1);  // the step at which a candidate was last counted
     for (int step = 0; have < want; ++step) {
       m.search(cur, -1, len, nullptr);
+      // The ratio's denominator: the travel time to the power oracle.time_exponent (< 1 favours
+      // the larger views farther away, which the camera also sees much on the way to).
       auto time_to = [&](size_t g, int b) {
         const float l = len[static_cast<size_t>(m.candidates[g])];
-        return l < kUnreached ? travel_time(l, cur_yaw, yaw_of(b), config_.cost) : -1.0;
+        return l < kUnreached ? std::pow(travel_time(l, cur_yaw, yaw_of(b), config_.cost), oc.time_exponent)
+                              : -1.0;
       };
       using Entry = std::tuple<double, int, int, bool>;  // ratio (bound), candidate, bin, exact
       std::priority_queue<Entry> heap;
@@ -643,7 +646,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           shown[static_cast<size_t>(e.element)] = 1, ++have;
       walk.emplace_back(pick_g, pick_b);
       summary_.tour_length += len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
-      summary_.tour_time += time_to(static_cast<size_t>(pick_g), pick_b);
+      summary_.tour_time += travel_time(len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])], cur_yaw,
+                                        yaw_of(pick_b), config_.cost);
       cur = m.candidates[static_cast<size_t>(pick_g)];
       cur_yaw = yaw_of(pick_b);
     }
@@ -785,6 +789,53 @@ std::vector<Eigen::Vector3d> OracleStrategy::truth_path(const Eigen::Vector3d& f
   return out;
 }
 
+void OracleStrategy::hold_square(std::vector<Eigen::Vector3d>& path, std::vector<double>& yaws) const {
+  if (!model_ || path.size() < 2) return;
+  const Model& m = *model_;
+  // Where the truth is closer than passage_clearance plus a voxel (the live map may grow a wall's
+  // face by one), the body passes with a face toward the obstacle: the heading is held at the
+  // direction of travel turned by the multiple of 90° nearest the heading it would have had. The
+  // controller brakes a trajectory whose turned body reaches within its bound (docs/controller.md,
+  // "The turned body"): an env3 run whose headings turned across doorways braked 11 times. Each
+  // end of such a stretch gets a waypoint, so the heading is held all through it.
+  const double narrow = config_.collision.passage_clearance + m.res;
+  auto tight = [&](const Eigen::Vector3d& p) { return m.checker.esdf(p, m.cap) < narrow; };
+  std::vector<Eigen::Vector3d> out{path.front()};
+  std::vector<double> out_yaw{yaws.front()};
+  std::vector<uint8_t> held{0};
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector3d a = path[i - 1], b = path[i];
+    const size_t first = out.size();  // this segment's points from here
+    const Eigen::Vector2d d = (b - a).head<2>();
+    const double travel = d.norm() > 1e-6 ? std::atan2(d.y(), d.x()) : yaws[i];
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.05)));
+    bool was = tight(a);
+    if (was) held.back() = 1;
+    for (int k = 1; k < n; ++k) {
+      const double f = static_cast<double>(k) / n;
+      const Eigen::Vector3d p = a + f * (b - a);
+      const bool now = tight(p);
+      if (now != was) {
+        out.push_back(p);
+        out_yaw.push_back(core::wrap_angle(yaws[i - 1] + f * core::wrap_angle(yaws[i] - yaws[i - 1])));
+        held.push_back(1);
+      }
+      was = now;
+    }
+    out.push_back(b);
+    out_yaw.push_back(yaws[i]);
+    held.push_back(tight(b) ? 1 : 0);
+    const double q = M_PI / 2;
+    for (size_t j = first - 1; j < out.size(); ++j)
+      if (held[j]) out_yaw[j] = core::wrap_angle(travel + q * std::round(core::wrap_angle(out_yaw[j] - travel) / q));
+  }
+  // The vehicle's heading is what it is; the goal keeps the yaw it was chosen for.
+  out_yaw.front() = yaws.front();
+  out_yaw.back() = yaws.back();
+  path = std::move(out);
+  yaws = std::move(out_yaw);
+}
+
 std::pair<double, double> OracleStrategy::coverage(const map::StateGrid& grid) const {
   if (!model_ || model_->targets.empty()) return {0.0, 0.0};
   const Model& m = *model_;
@@ -882,7 +933,8 @@ PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
       if (leg.empty() || path.size() + leg.size() > kMaxWaypoints) break;
       double len = 0.0;
       for (size_t k = 1; k < leg.size(); ++k) len += (leg[k] - leg[k - 1]).norm();
-      const std::vector<double> leg_yaws = interpolate_yaws(leg, from_yaw, v.yaw);
+      std::vector<double> leg_yaws = interpolate_yaws(leg, from_yaw, v.yaw);
+      hold_square(leg, leg_yaws);
       for (size_t k = 1; k < leg.size(); ++k) {
         path.push_back(leg[k]);
         yaws.push_back(leg_yaws[k]);

@@ -197,6 +197,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("clearance_penalty", c.oracle.clearance_penalty, 0.0, 1e6);
   o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
   o.get("first_pass", c.oracle.first_pass, 0.0, 1.0);
+  o.get("time_exponent", c.oracle.time_exponent, 0.0, 4.0);
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
   o.get("chain", c.oracle.chain, 1, 1000);
   o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);

@@ -95,6 +95,9 @@ class OracleStrategy : public Strategy {
   std::pair<double, double> coverage(const map::StateGrid& grid) const;
   // Path on the true free space from `from` to `to` (first waypoint `from`), empty when none.
   std::vector<Eigen::Vector3d> truth_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+  // Holds the heading square to the direction of travel where a path passes close to the truth's
+  // obstacles (adds a waypoint at each end of such a stretch).
+  void hold_square(std::vector<Eigen::Vector3d>& path, std::vector<double>& yaws) const;
   // The T voxels (keys) viewpoint i of the tour sees at its yaw, by the oracle's camera model.
   std::vector<map::VoxelKey> seen_by(size_t i) const;
 
