@@ -1,7 +1,6 @@
 #include "semx/planner/oracle_strategy.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -488,7 +487,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     return false;
   }
   if (!model_) model_ = std::make_unique<Model>(*truth_, config_);
-  fprintf(stderr, "TIMING model %.1f ms\n", watch.ms());
   Model& m = *model_;
   summary_.target = static_cast<int64_t>(m.targets.size());
 
@@ -541,7 +539,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       }
   }
   summary_.candidates = static_cast<int64_t>(m.candidates.size());
-  fprintf(stderr, "TIMING candidates %zu %.1f ms rays %zu steps %zu\n", m.candidates.size(), watch.ms(), m.frustum.size(), m.steps.size());
   if (m.candidates.empty()) {
     summary_.error = "no viewpoint on the true free space the vehicle can reach";
     return false;
@@ -661,7 +658,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   summary_.first_pass = static_cast<int64_t>(walk.size());
   summary_.viewpoints = static_cast<int64_t>(walk.size() + cover.picks.size());
   summary_.cover_dropped = cover.dropped;
-  fprintf(stderr, "TIMING cover walk %zu picks %zu evals %lld %.1f ms cache %zu MB\n", walk.size(), cover.picks.size(), (long long)cover.evaluations, watch.ms(), used >> 20);
 
   // 5. The tour of the picks, from where the first pass ended: node 0 that place, node i pick
   // i - 1. Path lengths from one search per distinct cell (a place picked at several yaws is one).
@@ -699,7 +695,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     }
   for (size_t i = 1; i <= k; ++i) cost[i][0] = cost[0][i];  // never used: the tour does not return
   const Tour t = solve_tour(cost, oc.exact_tour_max);
-  fprintf(stderr, "TIMING tour %.1f ms\n", watch.ms());
   picks_ = cover.picks;
   tour_costs_ = cost;
   tour_order_ = t.order;
