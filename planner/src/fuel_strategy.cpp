@@ -326,16 +326,6 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     if (std::any_of(sites_.begin(), sites_.end(), major))
       sites_.erase(std::remove_if(sites_.begin(), sites_.end(), [&](const Site& s) { return !major(s); }),
                    sites_.end());
-    if (std::getenv("SEMX_FUEL_DEBUG")) {
-      std::fprintf(stderr, "plan t=%.2f clusters=%zu sites:", 1e-6 * ctx.pose.utime, clusters_.clusters().size());
-      for (const auto& [id, cs] : state_) {
-        const FrontierClusters::Cluster* c = clusters_.find(id);
-        std::fprintf(stderr, " [%lld n=%zu m=(%.1f,%.1f,%.1f) v=%zu best=%.0f]", static_cast<long long>(id),
-                     c->voxels.size(), c->mean.x(), c->mean.y(), c->mean.z(), cs.views.size(),
-                     cs.views.empty() ? 0.0 : cs.views[0].coverage);
-      }
-      std::fprintf(stderr, "\n");
-    }
     if (waiting) *waiting = banned_only;
     if (sites_.empty()) {
       std::ostringstream r;
@@ -454,11 +444,6 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       ctx.counters->search_settled += expanded;
     }
     ctx.counters->connect_ms += pw.ms();
-    if (std::getenv("SEMX_FUEL_DEBUG"))
-      std::fprintf(stderr, "path t=%.2f from (%.2f %.2f %.2f) to (%.2f %.2f %.2f): %s, guide %zu, expanded %lld, %zu wp\n",
-                   1e-6 * ctx.pose.utime, vehicle_.x(), vehicle_.y(), vehicle_.z(), goal_view.position.x(),
-                   goal_view.position.y(), goal_view.position.z(), found ? "found" : "none", guide.size(),
-                   static_cast<long long>(expanded), waypoints.size());
     if (!found) {
       blacklist_.push_back({goal_view.position, ctx.cycle + config_.loop.blacklist_cycles});
       *reason = "no path to the tour's next viewpoint";

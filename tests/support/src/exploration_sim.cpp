@@ -114,22 +114,12 @@ ExplorationSimResult ExplorationSim::run(
   for (int64_t i = 1; i <= steps; ++i) {
     const double t = i * options_.dt;
     move(options_.dt);
-    if (world_.collides(pose_.position, body)) {
-      ++r.collisions;
-      if (std::getenv("SEMX_SIM_DEBUG"))
-        std::fprintf(stderr, "collision t=%.2f at (%.3f %.3f %.3f) yaw %.2f path %zu/%zu\n", t, pose_.position.x(),
-                     pose_.position.y(), pose_.position.z(), pose_.yaw, next_waypoint_, path_.waypoints.size());
-      if (std::getenv("SEMX_SIM_DEBUG"))
-        for (const auto& w : path_.waypoints) std::fprintf(stderr, "   wp (%.3f %.3f %.3f)\n", w.x(), w.y(), w.z());
-    }
+    if (world_.collides(pose_.position, body)) ++r.collisions;
     if (t + 1e-9 >= next_observe) {
       observe();
       update_regions(t, r);
       next_observe += options_.observe_period;
     }
-    if (std::getenv("SEMX_SIM_TRACE") && i % 5 == 0)
-      std::fprintf(stderr, "pose t=%.2f %.2f %.2f %.2f yaw %.2f\n", t, pose_.position.x(), pose_.position.y(),
-                   pose_.position.z(), pose_.yaw);
     pose_.utime = static_cast<int64_t>(std::llround(t * 1e6));
     planner_.set_pose(pose_);
     if (holding_ && planner_.plan_id() > 0)

@@ -18,6 +18,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "semx/runtime/args.hpp"
 
 namespace semx::bench {
@@ -29,17 +31,13 @@ namespace {
 // True when metrics.json says the run ended as a run ends (DONE, the time limit or the episode's
 // end), not stopped or still running: the evaluator writes the file on a Ctrl-C too.
 bool run_finished(const std::string& metrics) {
-  std::ifstream in(metrics);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string s = text.str();
-  const std::size_t key = s.find("\"termination\"");
-  if (key == std::string::npos) return false;
-  const std::size_t open = s.find('"', s.find(':', key));
-  if (open == std::string::npos) return false;
-  const std::size_t close = s.find('"', open + 1);
-  const std::string value = s.substr(open + 1, close == std::string::npos ? 0 : close - open - 1);
-  return value == "planner_done" || value == "time_limit" || value == "episode_end";
+  try {
+    const YAML::Node m = YAML::LoadFile(metrics);  // JSON is YAML
+    const std::string t = m["termination"] ? m["termination"].as<std::string>() : "";
+    return t == "planner_done" || t == "time_limit" || t == "episode_end";
+  } catch (const YAML::Exception&) {
+    return false;  // unreadable: not a run that ended
+  }
 }
 
 // Moves DIR/runs/NAME to the first free DIR/interrupted/NAME-K and returns that path.
