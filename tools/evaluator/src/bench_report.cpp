@@ -183,6 +183,8 @@ BenchRun load_bench_run(const std::string& dir) {
   r.world = text("world");
   r.planner = text("planner");
   r.termination = text("termination");
+  if (m["valid"] && m["valid"].IsScalar()) r.valid = m["valid"].as<bool>();
+  r.invalid_reason = text("invalid_reason");
   if (r.world.empty() || r.planner.empty()) throw std::runtime_error(file + ": no world or planner");
   r.seed = m["seed"] && !m["seed"].IsNull() ? m["seed"].as<int64_t>() : 0;
   r.samples = m["samples"] && !m["samples"].IsNull() ? m["samples"].as<int>() : 0;
@@ -254,7 +256,30 @@ void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptio
   }
 }
 
-std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
+static std::vector<BenchRun> valid_only(const std::vector<BenchRun>& runs) {
+  std::vector<BenchRun> out;
+  for (const auto& r : runs)
+    if (r.valid) out.push_back(r);
+  return out;
+}
+
+static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o);
+
+std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOptions& o) {
+  std::string md = tables_markdown(valid_only(all), o);
+  std::string left_out;
+  for (const auto& r : all) {
+    if (r.valid) continue;
+    left_out += "- " + r.dir + " (" + r.world + ", " + r.planner + ", seed " + std::to_string(r.seed) + "): " +
+                r.invalid_reason + "\n";
+  }
+  if (!left_out.empty()) {
+    md += "\n### Runs left out of the tables (not valid: lost or mixed messages)\n\n" + left_out;
+  }
+  return md;
+}
+
+static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
   std::ostringstream md;
   const auto worlds = worlds_of(runs);
   std::set<int> densities;
@@ -403,8 +428,9 @@ std::string bench_csv(const std::vector<BenchRun>& runs) {
   return c.str();
 }
 
-std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
+std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, const std::string& dir,
                                            const BenchReportOptions& o) {
+  const std::vector<BenchRun> runs = valid_only(all);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
     std::vector<const BenchRun*> here;
