@@ -117,7 +117,8 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
     regions_ = std::move(regions);
   });
   node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& m) {
-    if (m.lost > 0) lost_[m.node] = std::max(lost_[m.node], m.lost);
+    // A recorder's or viewer's losses leave its log or picture short, not the run.
+    if (m.lost > 0 && !m.observer) lost_[m.node] = std::max(lost_[m.node], m.lost);
   });
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
   // It publishes nothing but its map client's requests: with the mirror in sync the clock need
