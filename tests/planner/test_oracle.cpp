@@ -226,6 +226,7 @@ PlannerConfig tiny_config() {
   c.oracle.rays_azimuth = 128;
   c.oracle.rays_elevation = 24;
   c.oracle.first_pass = 0.0;  // the cover and one tour, as brute force checks them
+  c.oracle.target_share = 0.0;
   return c;
 }
 
