@@ -4,25 +4,31 @@
 //
 //   semx-perf-planner [--world apartment|two_rooms|env1|env2|env3] [--planner NAME] [--samples N]
 //                     [--seed N] [--runs N] [--max-time S] [--set KEY=VALUE]... [--fit] [--verbose]
-//                     [--kernels]
+//                     [--kernels] [--semantics] [--semantics-config FILE] [--time-split]
 //
 // env1-3 (the simulator's shipped worlds, voxelised by its ground truth) need the simulator
 // library at build time. --fit prints the least-squares charge coefficients of the cycle's wall
 // time against the work counters (docs/planner.md, "Planning time"). --kernels times the cycle's
 // two hot kernels on the first run's final map (stop it early with --max-time for a map with
 // frontiers): a gain evaluation, and ESDF reads along edges with the chunked cache against one
-// cube search per voxel centre.
+// cube search per voxel centre. --semantics emulates the semantics module with its class table
+// (every object of the world a region of its class's weight and radius once a voxel of it is
+// known; inactive once half its surface is). --time-split prints where each run's time went
+// (core/time_split.hpp, on the evaluator's target set T).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <functional>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "semx/core/random.hpp"
+#include "semx/core/time_split.hpp"
 #include "semx/fixtures/exploration_sim.hpp"
 #include "semx/fixtures/synthetic_truth.hpp"
 #include "semx/fixtures/synthetic_world.hpp"
@@ -37,6 +43,10 @@
 #ifdef SEMX_PERF_WITH_SIMULATOR
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
+#endif
+#ifdef SEMX_PERF_WITH_SEMANTICS
+#include "semx/semantics/config.hpp"
+#include "semx/semantics/regions.hpp"
 #endif
 
 using namespace semx::planner;
@@ -124,6 +134,26 @@ void time_kernels(const map::StateGrid& grid, const PlannerConfig& config) {
   }
 }
 
+// The evaluator's object voxels: occupied voxels of T whose cube overlaps an object's box.
+std::vector<map::VoxelKey> object_surface(const SyntheticWorld& world, const SyntheticTruth& truth) {
+  std::vector<map::VoxelKey> keys;
+  const map::KeyMath km(world.resolution());
+  const double half = 0.5 * world.resolution();
+  std::set<map::VoxelKey> seen;
+  for (const Box& b : world.objects()) {
+    const map::VoxelKey lo = km.key(b.min), hi = km.key(b.max);
+    for (int32_t z = lo.z; z <= hi.z; ++z)
+      for (int32_t y = lo.y; y <= hi.y; ++y)
+        for (int32_t x = lo.x; x <= hi.x; ++x) {
+          const map::VoxelKey k{x, y, z};
+          const Eigen::Vector3d c = km.center(k);
+          if (((c.array() + half) <= b.min.array()).any() || ((c.array() - half) >= b.max.array()).any()) continue;
+          if (world.occupied(k) && truth.target(k) && seen.insert(k).second) keys.push_back(k);
+        }
+  }
+  return keys;
+}
+
 std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resolution) {
   if (name == "apartment") return std::make_unique<SyntheticWorld>(SyntheticWorld::apartment(resolution));
   if (name == "two_rooms") return std::make_unique<SyntheticWorld>(SyntheticWorld::two_rooms(resolution));
@@ -139,9 +169,12 @@ std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resol
       },
       w.start.position, w.name);
   std::vector<Box> objects;
-  for (const semx::simulator::ObjectInfo& o : gt->objects())
+  std::vector<int> classes;
+  for (const semx::simulator::ObjectInfo& o : gt->objects()) {
     objects.push_back({o.center - 0.5 * o.extent, o.center + 0.5 * o.extent});
-  world->set_objects(std::move(objects));
+    classes.push_back(static_cast<int>(o.cls));
+  }
+  world->set_objects(std::move(objects), std::move(classes));
   return world;
 #else
   throw ArgError("unknown world '" + name + "' (apartment, two_rooms; env1-3 need the simulator library)");
@@ -155,7 +188,8 @@ int main(int argc, char** argv) {
     std::string world_name = "apartment", planner_name, config_file;
     int64_t samples = 0, seed = -1, runs = 1;
     double max_time = 900.0, semantic_weight = 0.0, coverage_period = 1.0;
-    bool fit = false, verbose = false, kernels = false, oracle = false;
+    bool fit = false, verbose = false, kernels = false, oracle = false, semantics = false, time_split = false;
+    std::string semantics_config;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
@@ -178,7 +212,12 @@ int main(int argc, char** argv) {
         .flag("verbose", "one line per cycle", &verbose)
         .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start",
               &oracle)
-        .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels);
+        .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels)
+        .flag("semantics", "emulated semantics with the semantics module's class table (weights, radii)", &semantics)
+        .option("semantics-config", "FILE", "semantics YAML for --semantics (default: the built-in defaults)",
+                &semantics_config)
+        .flag("time-split", "print where each run's time went: new space, revisits, turns, hover, end game",
+              &time_split);
     if (!p.parse(argc, argv)) return 0;
     // run_time_to_85 is read off these samples, so without them the figure would silently be -1.
     if (!(coverage_period > 0)) throw ArgError("--coverage-period: must be positive");
@@ -188,7 +227,23 @@ int main(int argc, char** argv) {
     if (seed >= 0) config.seed = seed;
     const double resolution = 0.1;
     const auto world = make_world(world_name, resolution);
-
+    std::function<bool(int, const Eigen::Vector3d&, double*, double*)> region_params;
+    if (semantics || !semantics_config.empty()) {
+#ifdef SEMX_PERF_WITH_SEMANTICS
+      semx::semantics::SemanticsConfig sc;
+      if (!semantics_config.empty()) sc = load_config<semx::semantics::SemanticsConfig>(semantics_config, {});
+      region_params = [regions = sc.regions](int cls, const Eigen::Vector3d& extent, double* w, double* r) {
+        const auto c = static_cast<semx::runtime::SemanticClass>(cls);
+        if (cls <= 0 || cls >= static_cast<int>(semx::runtime::SemanticClass::kCount) || !regions.of(c).enabled)
+          return false;
+        *w = semx::semantics::region_weight(regions, c);
+        *r = semx::semantics::region_radius(regions, c, extent);
+        return true;
+      };
+#else
+      throw ArgError("--semantics needs the semantics library at build time");
+#endif
+    }
     std::vector<double> cycle_cpu_ms, cycle_ms, sample_ms, connect_ms, gain_ms, search_ms, charged_ms, evals;
     std::vector<CycleCounters> counters;
     double coverage = 0, time_s = 0, distance = 0, time_85 = 0, time_95 = 0, objects_time = 0;
@@ -202,6 +257,7 @@ int main(int argc, char** argv) {
       ExplorationSimOptions o;
       o.max_time = max_time;
       o.semantic_weight = semantic_weight;
+      o.region_params = region_params;
       o.coverage_period = coverage_period;
       if (oracle) {
         std::vector<semx::map::VoxelKey> keys;
@@ -225,15 +281,32 @@ int main(int argc, char** argv) {
       const SyntheticTruth truth(*world);
       planner.set_truth(&truth);
       ExplorationSim sim(*world, planner, o);
-      // Coverage of T (the evaluator's measure), once a simulated second.
-      double t_cov_next = 0.0, t85 = -1.0, t95 = -1.0;
+      // Coverage of T (the evaluator's measure), twice a simulated second; Time_r and Time_95 read
+      // on whole seconds as before. The objects' surface voxels in T (the evaluator's Time_o).
+      const std::vector<semx::map::VoxelKey> object_voxels = object_surface(*world, truth);
+      double t_cov_next = 0.0, t85 = -1.0, t95 = -1.0, t_o = -1.0;
+      std::vector<std::pair<double, double>> t_curve;
+      semx::core::TimeSplit split;
       int64_t known_at_path = 0;
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
+        split.on_pose(t, sim.pose().position, sim.pose().yaw);
         if (t + 1e-9 >= t_cov_next) {
-          t_cov_next += 1.0;
-          const double cov = truth.coverage(sim.known());
-          if (t85 < 0 && cov >= 0.85) t85 = t;
-          if (t95 < 0 && cov >= 0.95) t95 = t;
+          const bool whole = std::abs(t_cov_next - std::round(t_cov_next)) < 1e-6;
+          t_cov_next += 0.5;
+          const int64_t covered = truth.covered(sim.known());
+          const double cov = static_cast<double>(covered) / static_cast<double>(std::max<int64_t>(1, truth.target_count()));
+          split.on_covered(t, covered);
+          t_curve.emplace_back(t, cov);
+          if (whole) {
+            if (t85 < 0 && cov >= 0.85) t85 = t;
+            if (t95 < 0 && cov >= 0.95) t95 = t;
+            if (t_o < 0 && !object_voxels.empty()) {
+              semx::map::StateGrid::Reader rd = sim.known().reader();
+              int64_t seen = 0;
+              for (const auto& k : object_voxels) seen += rd.state(k) != semx::map::VoxelState::kUnknown;
+              if (static_cast<double>(seen) >= 0.75 * static_cast<double>(object_voxels.size())) t_o = t;
+            }
+          }
         }
         if (verbose && out.path) {
           // What the goal just left behind added to the map: a goal's promise against its yield.
@@ -283,8 +356,27 @@ int main(int argc, char** argv) {
       std::printf("run_time_to_85: %.1f s\n", r.time_85);
       std::printf("run_end_game: %.1f s of %.1f s (settled at %.1f s, coverage %.2f %%)\n",
                   r.time_s - r.time_settled, r.time_s, r.time_settled, 100.0 * r.coverage);
-      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n",
-                  100.0 * truth.coverage(sim.known()), t85, t95, r.time_s);
+      const double final_t = truth.coverage(sim.known());
+      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * final_t, t85,
+                  t95, r.time_s);
+      std::printf("run_T_time_o: %.0f s (75 %% of %zu object surface voxels)\n", t_o, object_voxels.size());
+      if (time_split) {
+        split.on_covered(r.time_s, truth.covered(sim.known()));
+        double settled = r.time_s;
+        for (const auto& [t, c] : t_curve) {
+          if (c >= final_t - 0.005) {
+            settled = t;
+            break;
+          }
+        }
+        const semx::core::TimeSplitResult ts = split.finish(r.time_s, settled, resolution * resolution * resolution);
+        std::printf("run_time_split:");
+        for (int u = 0; u < semx::core::kTimeUses; ++u)
+          std::printf(" %s %.1f s %.1f m", semx::core::to_string(static_cast<semx::core::TimeUse>(u)),
+                      ts.time_s[static_cast<size_t>(u)], ts.distance_m[static_cast<size_t>(u)]);
+        std::printf(" | revisit_by_place %.1f m of %.1f m, time_f %.1f s, settled %.1f s\n", ts.revisit_by_place_m,
+                    ts.distance_total_m, ts.time_f, ts.time_settled);
+      }
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
         ++reached_85;
