@@ -4,7 +4,7 @@
 //
 //   semx-perf-planner [--world apartment|two_rooms|env1|env2|env3] [--planner NAME] [--samples N]
 //                     [--seed N] [--runs N] [--max-time S] [--set KEY=VALUE]... [--fit] [--verbose]
-//                     [--kernels] [--semantics] [--semantics-config FILE] [--time-split]
+//                     [--kernels] [--semantics] [--semantics-config FILE] [--time-split] [--out DIR]
 //
 // env1-3 (the simulator's shipped worlds, voxelised by its ground truth) need the simulator
 // library at build time. --fit prints the least-squares charge coefficients of the cycle's wall
@@ -14,7 +14,10 @@
 // cube search per voxel centre. --semantics emulates the semantics module with its class table
 // (every object of the world a region of its class's weight and radius once a voxel of it is
 // known; inactive once half its surface is). --time-split prints where each run's time went
-// (core/time_split.hpp, on the evaluator's target set T).
+// (core/time_split.hpp, on the evaluator's target set T). --out DIR writes each run's folder as
+// the evaluator does (DIR/runs/WORLD-PLANNER-sSAMPLES-seedN/: metrics.json, coverage.csv,
+// time_split.json, ...; the figures on T, "source": "closed-loop"), so semx-bench-report DIR
+// compares planners seed by seed.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
@@ -23,6 +26,7 @@
 #include <iostream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -43,6 +47,10 @@
 #ifdef SEMX_PERF_WITH_SIMULATOR
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
+#endif
+#ifdef SEMX_PERF_WITH_EVALUATOR
+#include "semx/evaluator/run_folder.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
 #endif
 #ifdef SEMX_PERF_WITH_SEMANTICS
 #include "semx/semantics/config.hpp"
@@ -154,11 +162,17 @@ std::vector<map::VoxelKey> object_surface(const SyntheticWorld& world, const Syn
   return keys;
 }
 
+#ifdef SEMX_PERF_WITH_SIMULATOR
+// The simulator's world the closed loop explores, when it is one (for the run folder's pictures).
+std::optional<semx::simulator::World> g_sim_world;
+#endif
+
 std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resolution) {
   if (name == "apartment") return std::make_unique<SyntheticWorld>(SyntheticWorld::apartment(resolution));
   if (name == "two_rooms") return std::make_unique<SyntheticWorld>(SyntheticWorld::two_rooms(resolution));
 #ifdef SEMX_PERF_WITH_SIMULATOR
   const semx::simulator::World w = semx::simulator::load_world(semx::simulator::shipped_world_path(name));
+  g_sim_world = w;
   auto gt = std::make_shared<semx::simulator::GroundTruth>(w, resolution);
   Box interior{w.bounds.min, w.bounds.max};
   auto world = std::make_unique<SyntheticWorld>(
@@ -189,7 +203,7 @@ int main(int argc, char** argv) {
     int64_t samples = 0, seed = -1, runs = 1;
     double max_time = 900.0, semantic_weight = 0.0, coverage_period = 1.0;
     bool fit = false, verbose = false, kernels = false, oracle = false, semantics = false, time_split = false;
-    std::string semantics_config;
+    std::string semantics_config, out_dir;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3", &world_name)
@@ -217,7 +231,9 @@ int main(int argc, char** argv) {
         .option("semantics-config", "FILE", "semantics YAML for --semantics (default: the built-in defaults)",
                 &semantics_config)
         .flag("time-split", "print where each run's time went: new space, revisits, turns, hover, end game",
-              &time_split);
+              &time_split)
+        .option("out", "DIR", "write each run's folder under DIR/runs/ (metrics.json, ...) for semx-bench-report",
+                &out_dir);
     if (!p.parse(argc, argv)) return 0;
     // run_time_to_85 is read off these samples, so without them the figure would silently be -1.
     if (!(coverage_period > 0)) throw ArgError("--coverage-period: must be positive");
@@ -360,16 +376,66 @@ int main(int argc, char** argv) {
       std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * final_t, t85,
                   t95, r.time_s);
       std::printf("run_T_time_o: %.0f s (75 %% of %zu object surface voxels)\n", t_o, object_voxels.size());
-      if (time_split) {
-        split.on_covered(r.time_s, truth.covered(sim.known()));
-        double settled = r.time_s;
-        for (const auto& [t, c] : t_curve) {
-          if (c >= final_t - 0.005) {
-            settled = t;
-            break;
-          }
+      split.on_covered(r.time_s, truth.covered(sim.known()));
+      double settled = r.time_s;
+      for (const auto& [t, c] : t_curve) {
+        if (c >= final_t - 0.005) {
+          settled = t;
+          break;
         }
-        const semx::core::TimeSplitResult ts = split.finish(r.time_s, settled, resolution * resolution * resolution);
+      }
+      const semx::core::TimeSplitResult ts = split.finish(r.time_s, settled, resolution * resolution * resolution);
+      if (!out_dir.empty()) {
+#ifdef SEMX_PERF_WITH_EVALUATOR
+        namespace ev = semx::evaluator;
+        ev::RunSummary s;
+        s.info.world = world->name();
+        s.info.world_path = world_name;
+        s.info.planner = c.planner;
+        s.info.seed = c.seed;
+        s.info.samples = c.sampling.samples;
+        s.info.source = "closed-loop";
+        s.time_f_s = r.time_s;
+        s.distance_m = r.distance;
+        s.coverage_pct = 100.0 * final_t;
+        if (t85 >= 0) s.time_r_s = t85;
+        if (t95 >= 0) s.time_95_s = t95;
+        s.time_settled_s = settled;
+        s.end_game_s = std::max(0.0, r.time_s - settled);
+        if (t_o >= 0) s.time_o_s = t_o;
+        s.collisions = r.collisions;
+        s.termination = r.done ? "planner_done" : "time_limit";
+        s.planner_state = r.done ? "DONE" : "EXECUTING";
+        s.planner_reason = r.reason;
+        s.sim_s = r.time_s;
+        s.time_limit_s = max_time;
+        s.resolution_m = resolution;
+        s.target_voxels = truth.target_count();
+        s.covered_voxels = truth.covered(sim.known());
+        for (const auto& [t, cov] : t_curve) {
+          ev::CoverageSample cs;
+          cs.t_s = t;
+          cs.coverage_pct = 100.0 * cov;
+          s.coverage.push_back(cs);
+        }
+        s.time_split = ts;
+        std::string stem = world->name();
+        for (char& ch : stem)
+          if (ch == '/' || ch == ' ') ch = '_';
+        const std::string dir = out_dir + "/runs/" + stem + "-" + c.planner + "-s" +
+                                std::to_string(c.sampling.samples) + "-seed" + std::to_string(c.seed);
+        ev::write_run_metrics(dir, s);
+#ifdef SEMX_PERF_WITH_SIMULATOR
+        if (g_sim_world)
+          ev::time_split_picture(sim.known(), *g_sim_world, nullptr, ts,
+                                 "where the time went: " + world->name() + ", " + c.planner + " (closed loop)")
+              .write_png(dir + "/time_split.png");
+#endif
+#else
+        throw ArgError("--out needs the evaluator library at build time");
+#endif
+      }
+      if (time_split) {
         std::printf("run_time_split:");
         for (int u = 0; u < semx::core::kTimeUses; ++u)
           std::printf(" %s %.1f s %.1f m", semx::core::to_string(static_cast<semx::core::TimeUse>(u)),

@@ -26,6 +26,10 @@ struct BenchRun {
   std::optional<double> object_coverage_pct;
   int64_t collisions = 0;
   std::vector<std::pair<double, double>> coverage;  // (t s, %)
+  // time_split.json (empty when the folder has none): seconds of new, revisit, turn, hover and
+  // end game, and the metres flown over ground flown before.
+  std::vector<double> split_s;
+  double revisit_by_place_m = 0;
 };
 
 // Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
@@ -44,6 +48,10 @@ struct BenchReportOptions {
   int comparison_samples = 45;                 // the density of the planner comparison
   double threshold_pct = 85.0;
 };
+
+// Worlds whose name starts with this (semx-world gen's names) are also compared as one set: the
+// runs paired by world and seed, differences relative to the baseline's run.
+inline constexpr const char* kGeneratedPrefix = "generated";
 
 // Markdown: the sweep table, the comparison table (with Time_95, the end game and Time_o, the
 // objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
