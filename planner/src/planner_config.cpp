@@ -212,6 +212,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   rm.get("finish_gain", c.room.finish_gain, 0.0, 1e9);
   rm.get("eq6_reward", c.room.eq6_reward);
   rm.get("tour", c.room.tour);
+  rm.get("boundary_gain", c.room.boundary_gain);
 }
 
 }  // namespace semx::planner

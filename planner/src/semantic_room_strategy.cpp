@@ -74,9 +74,9 @@ void SemanticRoomStrategy::choose_target(PlanContext& ctx, int rooms) {
     for (const RoadmapNode& n : graph().slots()) {
       const int r = room_[static_cast<size_t>(n.id)];
       if (r < 0 || n.passage || n.blacklisted_until >= ctx.cycle || !n.gain.valid) continue;
-      if (n.gain.gain < rules_.finish_gain) continue;
+      if (room_gain(n) < rules_.finish_gain) continue;
       int64_t& b = best[static_cast<size_t>(r)];
-      if (b < 0 || n.gain.gain > graph().node(b).gain.gain) b = n.id;
+      if (b < 0 || room_gain(n) > room_gain(graph().node(b))) b = n.id;
     }
     for (int64_t b : best) {
       if (b >= 0 && graph().node(b).gain_stale) {
@@ -121,8 +121,15 @@ DepStrategy::TierFn SemanticRoomStrategy::tiers(PlanContext& ctx, bool* labelled
     }
     if (target_ < 0 || room_[static_cast<size_t>(id)] != target_) return 0;
     // Gains are upper bounds until re-evaluated (stale ones come back with their new gain).
-    return graph().node(id).gain.gain >= rules_.finish_gain ? 1 : 0;
+    return room_gain(graph().node(id)) >= rules_.finish_gain ? 1 : 0;
   };
+}
+
+double SemanticRoomStrategy::room_gain(const RoadmapNode& n) const {
+  if (!rules_.boundary_gain) return n.gain.gain;
+  const GainConfig& g = config().gain;
+  return g.weight_frontier * static_cast<double>(n.gain.counts[1]) +
+         g.weight_surface * static_cast<double>(n.gain.counts[2]);
 }
 
 PlanOutcome SemanticRoomStrategy::plan(PlanContext& ctx) {

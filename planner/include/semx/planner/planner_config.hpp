@@ -179,6 +179,11 @@ struct RoomConfig {
   // node; tour_solver.hpp), and only the first room's nodes of finish_gain are goals while any
   // is left. false: the vehicle's own room first, then DEP's ranking.
   bool tour = false;
+  // What "gain left in the room" counts: false, G itself; true, only its frontier and surface
+  // voxels (w_f U_f + w_s U_s at the best window). G counts unknown space behind walls too (unknown
+  // does not occlude), so next to an unexplored room a room's nodes keep a large G that staying
+  // in the room never lowers; its frontier and surface voxels are what looking around it shows.
+  bool boundary_gain = false;
   // The paper's Eq. 6 reward on top (as semantic-dep); false: G / T_path alone.
   bool eq6_reward = true;
 };

@@ -48,6 +48,8 @@ class SemanticRoomStrategy : public DepStrategy {
   void choose_target(PlanContext& ctx, int rooms);
   // The tier of node `id` (labels the rooms on its first call of a cycle: after the search).
   TierFn tiers(PlanContext& ctx, bool* labelled);
+  // The gain finish_gain is compared with (RoomConfig::boundary_gain).
+  double room_gain(const RoadmapNode& n) const;
 
   RoomConfig rules_;
   std::vector<int> room_;  // per slot
