@@ -476,7 +476,7 @@ DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t i
 }
 
 Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                              int64_t* unreachable, bool sweep) {
+                              int64_t* unreachable, bool sweep, const TierFn* tier) {
   {
     core::Stopwatch w;
     search_ = graph_.shortest_paths(root_);
@@ -508,7 +508,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   const double local = config_.cost.local_first;
   auto push = [&](double s, int64_t id) {
     const double d = search_.distance[static_cast<size_t>(id)];
-    queue.emplace(local > 0 && d <= local ? 1 : 0, s, -id);
+    queue.emplace(tier ? (*tier)(id) : local > 0 && d <= local ? 1 : 0, s, -id);
   };
   int64_t reachable = 0;
   const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
@@ -592,7 +592,9 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   return goal;
 }
 
-PlanOutcome DepStrategy::plan(PlanContext& ctx) {
+PlanOutcome DepStrategy::plan(PlanContext& ctx) { return plan_with(ctx, nullptr); }
+
+PlanOutcome DepStrategy::plan_with(PlanContext& ctx, const TierFn* tier) {
   checker_.set_grid(ctx.grid);
   checker_.reset_counters();
   process_map_changes(ctx);
@@ -604,7 +606,8 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
   bridge(ctx);
 
   PlanOutcome out;
-  out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep);
+  out.goal =
+      select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep, tier);
   if (out.goal.valid && in_end_game(ctx)) {
     int stops = 0;
     Goal g = tour_goal(ctx, paper_score(), &stops);

@@ -3,6 +3,7 @@
 #include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/nbv_strategy.hpp"
 #include "semx/planner/oracle_strategy.hpp"
+#include "semx/planner/semantic_room_strategy.hpp"
 #include "semx/planner/strategy.hpp"
 
 namespace semx::planner {
@@ -21,6 +22,8 @@ std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
       return std::make_unique<FuelStrategy>(config);
     case PlannerKind::kOracle:
       return std::make_unique<OracleStrategy>(config);
+    case PlannerKind::kSemanticRoom:
+      return std::make_unique<SemanticRoomStrategy>(config);
   }
   return nullptr;
 }

@@ -20,6 +20,8 @@ const char* to_string(PlannerKind k) {
       return "fuel";
     case PlannerKind::kOracle:
       return "oracle";
+    case PlannerKind::kSemanticRoom:
+      return "semantic-room";
   }
   return "?";
 }
@@ -31,7 +33,9 @@ PlannerKind parse_planner_kind(const std::string& name) {
   if (name == "aep") return PlannerKind::kAep;
   if (name == "fuel") return PlannerKind::kFuel;
   if (name == "oracle") return PlannerKind::kOracle;
-  throw std::invalid_argument("unknown planner '" + name + "' (semantic-dep, dep, nbv, aep, fuel, oracle)");
+  if (name == "semantic-room") return PlannerKind::kSemanticRoom;
+  throw std::invalid_argument("unknown planner '" + name +
+                              "' (semantic-dep, dep, nbv, aep, fuel, oracle, semantic-room)");
 }
 
 double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
@@ -53,7 +57,7 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle"});
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 
@@ -204,6 +208,14 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
   o.get("chain", c.oracle.chain, 1, 1000);
   o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);
+
+  auto rm = m.child("room");
+  rm.get("door_radius", c.room.door_radius, 0.0, 10.0);
+  rm.get("passages_bound", c.room.passages_bound);
+  rm.get("finish_gain", c.room.finish_gain, 0.0, 1e9);
+  rm.get("eq6_reward", c.room.eq6_reward);
+  rm.get("tour", c.room.tour);
+  rm.get("boundary_gain", c.room.boundary_gain);
 }
 
 }  // namespace semx::planner

@@ -4,25 +4,35 @@
 //
 //   semx-perf-planner [--world apartment|two_rooms|env1|env2|env3|FILE] [--planner NAME] [--samples N]
 //                     [--seed N] [--runs N] [--max-time S] [--set KEY=VALUE]... [--fit] [--verbose]
-//                     [--kernels]
+//                     [--kernels] [--semantics] [--semantics-config FILE] [--time-split] [--out DIR]
 //
 // env1-3 (the simulator's shipped worlds, voxelised by its ground truth) need the simulator
 // library at build time. --fit prints the least-squares charge coefficients of the cycle's wall
 // time against the work counters (docs/planner.md, "Planning time"). --kernels times the cycle's
 // two hot kernels on the first run's final map (stop it early with --max-time for a map with
 // frontiers): a gain evaluation, and ESDF reads along edges with the chunked cache against one
-// cube search per voxel centre.
+// cube search per voxel centre. --semantics emulates the semantics module with its class table
+// (every object of the world a region of its class's weight and radius once a voxel of it is
+// known; inactive once half its surface is). --time-split prints where each run's time went
+// (core/time_split.hpp, on the evaluator's target set T). --out DIR writes each run's folder as
+// the evaluator does (DIR/runs/WORLD-PLANNER-sSAMPLES-seedN/: metrics.json, coverage.csv,
+// time_split.json, ...; the figures on T, "source": "closed-loop"), so semx-bench-report DIR
+// compares planners seed by seed.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <functional>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "semx/core/random.hpp"
+#include "semx/core/time_split.hpp"
 #include "semx/fixtures/exploration_sim.hpp"
 #include "semx/fixtures/synthetic_truth.hpp"
 #include "semx/fixtures/synthetic_world.hpp"
@@ -37,6 +47,14 @@
 #ifdef SEMX_PERF_WITH_SIMULATOR
 #include "semx/simulator/ground_truth.hpp"
 #include "semx/simulator/world.hpp"
+#endif
+#ifdef SEMX_PERF_WITH_EVALUATOR
+#include "semx/evaluator/run_folder.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
+#endif
+#ifdef SEMX_PERF_WITH_SEMANTICS
+#include "semx/semantics/config.hpp"
+#include "semx/semantics/regions.hpp"
 #endif
 
 using namespace semx::planner;
@@ -124,11 +142,37 @@ void time_kernels(const map::StateGrid& grid, const PlannerConfig& config) {
   }
 }
 
+// The evaluator's object voxels: occupied voxels of T whose cube overlaps an object's box.
+std::vector<map::VoxelKey> object_surface(const SyntheticWorld& world, const SyntheticTruth& truth) {
+  std::vector<map::VoxelKey> keys;
+  const map::KeyMath km(world.resolution());
+  const double half = 0.5 * world.resolution();
+  std::set<map::VoxelKey> seen;
+  for (const Box& b : world.objects()) {
+    const map::VoxelKey lo = km.key(b.min), hi = km.key(b.max);
+    for (int32_t z = lo.z; z <= hi.z; ++z)
+      for (int32_t y = lo.y; y <= hi.y; ++y)
+        for (int32_t x = lo.x; x <= hi.x; ++x) {
+          const map::VoxelKey k{x, y, z};
+          const Eigen::Vector3d c = km.center(k);
+          if (((c.array() + half) <= b.min.array()).any() || ((c.array() - half) >= b.max.array()).any()) continue;
+          if (world.occupied(k) && truth.target(k) && seen.insert(k).second) keys.push_back(k);
+        }
+  }
+  return keys;
+}
+
+#ifdef SEMX_PERF_WITH_SIMULATOR
+// The simulator's world the closed loop explores, when it is one (for the run folder's pictures).
+std::optional<semx::simulator::World> g_sim_world;
+#endif
+
 std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resolution) {
   if (name == "apartment") return std::make_unique<SyntheticWorld>(SyntheticWorld::apartment(resolution));
   if (name == "two_rooms") return std::make_unique<SyntheticWorld>(SyntheticWorld::two_rooms(resolution));
 #ifdef SEMX_PERF_WITH_SIMULATOR
   const semx::simulator::World w = semx::simulator::load_world(semx::simulator::shipped_world_path(name));
+  g_sim_world = w;
   auto gt = std::make_shared<semx::simulator::GroundTruth>(w, resolution);
   Box interior{w.bounds.min, w.bounds.max};
   auto world = std::make_unique<SyntheticWorld>(
@@ -139,9 +183,12 @@ std::unique_ptr<SyntheticWorld> make_world(const std::string& name, double resol
       },
       w.start.position, w.name);
   std::vector<Box> objects;
-  for (const semx::simulator::ObjectInfo& o : gt->objects())
+  std::vector<int> classes;
+  for (const semx::simulator::ObjectInfo& o : gt->objects()) {
     objects.push_back({o.center - 0.5 * o.extent, o.center + 0.5 * o.extent});
-  world->set_objects(std::move(objects));
+    classes.push_back(static_cast<int>(o.cls));
+  }
+  world->set_objects(std::move(objects), std::move(classes));
   return world;
 #else
   throw ArgError("unknown world '" + name + "' (apartment, two_rooms; env1-3 need the simulator library)");
@@ -155,7 +202,8 @@ int main(int argc, char** argv) {
     std::string world_name = "apartment", planner_name, config_file;
     int64_t samples = 0, seed = -1, runs = 1;
     double max_time = 900.0, semantic_weight = 0.0, coverage_period = 1.0;
-    bool fit = false, verbose = false, kernels = false, oracle = false;
+    bool fit = false, verbose = false, kernels = false, oracle = false, semantics = false, time_split = false;
+    std::string semantics_config, out_dir;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
     p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3, or a world file (semx-world gen)", &world_name)
@@ -178,7 +226,14 @@ int main(int argc, char** argv) {
         .flag("verbose", "one line per cycle", &verbose)
         .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start",
               &oracle)
-        .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels);
+        .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels)
+        .flag("semantics", "emulated semantics with the semantics module's class table (weights, radii)", &semantics)
+        .option("semantics-config", "FILE", "semantics YAML for --semantics (default: the built-in defaults)",
+                &semantics_config)
+        .flag("time-split", "print where each run's time went: new space, revisits, turns, hover, end game",
+              &time_split)
+        .option("out", "DIR", "write each run's folder under DIR/runs/ (metrics.json, ...) for semx-bench-report",
+                &out_dir);
     if (!p.parse(argc, argv)) return 0;
     // run_time_to_85 is read off these samples, so without them the figure would silently be -1.
     if (!(coverage_period > 0)) throw ArgError("--coverage-period: must be positive");
@@ -188,7 +243,23 @@ int main(int argc, char** argv) {
     if (seed >= 0) config.seed = seed;
     const double resolution = 0.1;
     const auto world = make_world(world_name, resolution);
-
+    std::function<bool(int, const Eigen::Vector3d&, double*, double*)> region_params;
+    if (semantics || !semantics_config.empty()) {
+#ifdef SEMX_PERF_WITH_SEMANTICS
+      semx::semantics::SemanticsConfig sc;
+      if (!semantics_config.empty()) sc = load_config<semx::semantics::SemanticsConfig>(semantics_config, {});
+      region_params = [regions = sc.regions](int cls, const Eigen::Vector3d& extent, double* w, double* r) {
+        const auto c = static_cast<semx::runtime::SemanticClass>(cls);
+        if (cls <= 0 || cls >= static_cast<int>(semx::runtime::SemanticClass::kCount) || !regions.of(c).enabled)
+          return false;
+        *w = semx::semantics::region_weight(regions, c);
+        *r = semx::semantics::region_radius(regions, c, extent);
+        return true;
+      };
+#else
+      throw ArgError("--semantics needs the semantics library at build time");
+#endif
+    }
     std::vector<double> cycle_cpu_ms, cycle_ms, sample_ms, connect_ms, gain_ms, search_ms, charged_ms, evals;
     std::vector<CycleCounters> counters;
     double coverage = 0, time_s = 0, distance = 0, time_85 = 0, time_95 = 0, objects_time = 0;
@@ -202,6 +273,7 @@ int main(int argc, char** argv) {
       ExplorationSimOptions o;
       o.max_time = max_time;
       o.semantic_weight = semantic_weight;
+      o.region_params = region_params;
       o.coverage_period = coverage_period;
       if (oracle) {
         std::vector<semx::map::VoxelKey> keys;
@@ -225,17 +297,32 @@ int main(int argc, char** argv) {
       const SyntheticTruth truth(*world);
       planner.set_truth(&truth);
       ExplorationSim sim(*world, planner, o);
-      // Coverage of T (the evaluator's measure), every coverage period.
-      double t_cov_next = 0.0, t85 = -1.0, t95 = -1.0;
+      // Coverage of T (the evaluator's measure), twice a simulated second; Time_r and Time_95 read
+      // on whole seconds as before. The objects' surface voxels in T (the evaluator's Time_o).
+      const std::vector<semx::map::VoxelKey> object_voxels = object_surface(*world, truth);
+      double t_cov_next = 0.0, t85 = -1.0, t95 = -1.0, t_o = -1.0;
       std::vector<std::pair<double, double>> t_curve;
+      semx::core::TimeSplit split;
       int64_t known_at_path = 0;
       const ExplorationSimResult r = sim.run([&](double t, const ExplorationPlanner::Output& out) {
+        split.on_pose(t, sim.pose().position, sim.pose().yaw);
         if (t + 1e-9 >= t_cov_next) {
-          t_cov_next += coverage_period;
-          const double cov = truth.coverage(sim.known());
+          const bool whole = std::abs(t_cov_next - std::round(t_cov_next)) < 1e-6;
+          t_cov_next += 0.5;
+          const int64_t covered = truth.covered(sim.known());
+          const double cov = static_cast<double>(covered) / static_cast<double>(std::max<int64_t>(1, truth.target_count()));
+          split.on_covered(t, covered);
           t_curve.emplace_back(t, cov);
-          if (t85 < 0 && cov >= 0.85) t85 = t;
-          if (t95 < 0 && cov >= 0.95) t95 = t;
+          if (whole) {
+            if (t85 < 0 && cov >= 0.85) t85 = t;
+            if (t95 < 0 && cov >= 0.95) t95 = t;
+            if (t_o < 0 && !object_voxels.empty()) {
+              semx::map::StateGrid::Reader rd = sim.known().reader();
+              int64_t seen = 0;
+              for (const auto& k : object_voxels) seen += rd.state(k) != semx::map::VoxelState::kUnknown;
+              if (static_cast<double>(seen) >= 0.75 * static_cast<double>(object_voxels.size())) t_o = t;
+            }
+          }
         }
         if (verbose && out.path) {
           // What the goal just left behind added to the map: a goal's promise against its yield.
@@ -285,24 +372,83 @@ int main(int argc, char** argv) {
       std::printf("run_time_to_85: %.1f s\n", r.time_85);
       std::printf("run_end_game: %.1f s of %.1f s (settled at %.1f s, coverage %.2f %%)\n",
                   r.time_s - r.time_settled, r.time_s, r.time_settled, 100.0 * r.coverage);
-      // The evaluator's end game on T: Time_f - the first sample within 0.5 points of the final.
-      const double t_final = truth.coverage(sim.known());
-      t_curve.emplace_back(r.time_s, t_final);
-      if (t95 < 0 && t_final >= 0.95) t95 = r.time_s;
-      double t_settled = r.time_s;
-      for (const auto& [t, cov] : t_curve)
-        if (cov >= t_final - 0.005) {
-          t_settled = t;
+      const double final_t = truth.coverage(sim.known());
+      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * final_t, t85,
+                  t95, r.time_s);
+      std::printf("run_T_time_o: %.0f s (75 %% of %zu object surface voxels)\n", t_o, object_voxels.size());
+      split.on_covered(r.time_s, truth.covered(sim.known()));
+      double settled = r.time_s;
+      for (const auto& [t, c] : t_curve) {
+        if (c >= final_t - 0.005) {
+          settled = t;
           break;
         }
-      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * t_final, t85,
-                  t95, r.time_s);
+      }
       // One line per run for scripts: the evaluator's figures on T.
       std::printf("run_summary: world=%s planner=%s seed=%lld T=%.3f t85=%.1f t95=%.1f settled=%.1f time_f=%.1f "
                   "end_game=%.1f distance=%.2f collisions=%lld done=%d\n",
-                  world->name().c_str(), c.planner.c_str(), static_cast<long long>(c.seed), 100.0 * t_final, t85,
-                  t95, t_settled, r.time_s, r.time_s - t_settled, r.distance, static_cast<long long>(r.collisions),
+                  world->name().c_str(), c.planner.c_str(), static_cast<long long>(c.seed), 100.0 * final_t, t85,
+                  t95, settled, r.time_s, r.time_s - settled, r.distance, static_cast<long long>(r.collisions),
                   r.done ? 1 : 0);
+      const semx::core::TimeSplitResult ts = split.finish(r.time_s, settled, resolution * resolution * resolution);
+      if (!out_dir.empty()) {
+#ifdef SEMX_PERF_WITH_EVALUATOR
+        namespace ev = semx::evaluator;
+        ev::RunSummary s;
+        s.info.world = world->name();
+        s.info.world_path = world_name;
+        s.info.planner = c.planner;
+        s.info.seed = c.seed;
+        s.info.samples = c.sampling.samples;
+        s.info.source = "closed-loop";
+        s.time_f_s = r.time_s;
+        s.distance_m = r.distance;
+        s.coverage_pct = 100.0 * final_t;
+        if (t85 >= 0) s.time_r_s = t85;
+        if (t95 >= 0) s.time_95_s = t95;
+        s.time_settled_s = settled;
+        s.end_game_s = std::max(0.0, r.time_s - settled);
+        if (t_o >= 0) s.time_o_s = t_o;
+        s.collisions = r.collisions;
+        s.termination = r.done ? "planner_done" : "time_limit";
+        s.planner_state = r.done ? "DONE" : "EXECUTING";
+        s.planner_reason = r.reason;
+        s.sim_s = r.time_s;
+        s.time_limit_s = max_time;
+        s.resolution_m = resolution;
+        s.target_voxels = truth.target_count();
+        s.covered_voxels = truth.covered(sim.known());
+        for (const auto& [t, cov] : t_curve) {
+          ev::CoverageSample cs;
+          cs.t_s = t;
+          cs.coverage_pct = 100.0 * cov;
+          s.coverage.push_back(cs);
+        }
+        s.time_split = ts;
+        std::string stem = world->name();
+        for (char& ch : stem)
+          if (ch == '/' || ch == ' ') ch = '_';
+        const std::string dir = out_dir + "/runs/" + stem + "-" + c.planner + "-s" +
+                                std::to_string(c.sampling.samples) + "-seed" + std::to_string(c.seed);
+        ev::write_run_metrics(dir, s);
+#ifdef SEMX_PERF_WITH_SIMULATOR
+        if (g_sim_world)
+          ev::time_split_picture(sim.known(), *g_sim_world, nullptr, ts,
+                                 "where the time went: " + world->name() + ", " + c.planner + " (closed loop)")
+              .write_png(dir + "/time_split.png");
+#endif
+#else
+        throw ArgError("--out needs the evaluator library at build time");
+#endif
+      }
+      if (time_split) {
+        std::printf("run_time_split:");
+        for (int u = 0; u < semx::core::kTimeUses; ++u)
+          std::printf(" %s %.1f s %.1f m", semx::core::to_string(static_cast<semx::core::TimeUse>(u)),
+                      ts.time_s[static_cast<size_t>(u)], ts.distance_m[static_cast<size_t>(u)]);
+        std::printf(" | revisit_by_place %.1f m of %.1f m, time_f %.1f s, settled %.1f s\n", ts.revisit_by_place_m,
+                    ts.distance_total_m, ts.time_f, ts.time_settled);
+      }
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
         ++reached_85;

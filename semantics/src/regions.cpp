@@ -5,6 +5,14 @@
 
 namespace semx::semantics {
 
+double region_weight(const RegionConfig& config, runtime::SemanticClass cls) {
+  return config.weight_scale * config.of(cls).weight;
+}
+
+double region_radius(const RegionConfig& config, runtime::SemanticClass cls, const Eigen::Vector3d& extent) {
+  return config.of(cls).radius + config.radius_extent_gain * 0.5 * extent.norm();
+}
+
 std::vector<Region> make_regions(const std::vector<Track>& tracks, const RegionConfig& config) {
   std::vector<Region> out;
   for (const Track& t : tracks) {
@@ -17,8 +25,8 @@ std::vector<Region> make_regions(const std::vector<Track>& tracks, const RegionC
     r.instance = t.instance;
     r.centroid = t.centroid();
     r.extent = t.extent();
-    r.weight = config.weight_scale * p.weight;
-    r.radius = p.radius + config.radius_extent_gain * 0.5 * r.extent.norm();
+    r.weight = region_weight(config, t.cls);
+    r.radius = region_radius(config, t.cls, r.extent);
     r.confidence = t.probability();
     r.observations = t.observations;
     r.observed_fraction = t.observed_fraction;

@@ -108,6 +108,32 @@ TEST(BenchReport, SeedBySeedComparisonCountsWinsAndGivesTheIntervalOfTheDifferen
       << md;
 }
 
+// Generated worlds are also compared as one set, each run paired with the baseline's run of
+// the same world and seed, with the relative difference; time_split.json becomes a table.
+TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
+  const std::string root = test::temp_dir("bench_report_generated");
+  write_run(root, "generated-s1-a50-r1", "semantic-dep", 1, 100, 10, 1);
+  write_run(root, "generated-s1-a50-r1", "dep", 1, 100, 20, 1);
+  write_run(root, "generated-s2-a90-r3", "semantic-dep", 1, 100, 30, 1);
+  write_run(root, "generated-s2-a90-r3", "dep", 1, 100, 40, 1);
+  write_run(root, "env1", "semantic-dep", 1, 100, 5, 1);  // not generated: not in the set
+  write_run(root, "env1", "dep", 1, 100, 50, 1);
+  const fs::path split = fs::path(root) / "generated-s1-a50-r1-dep-s45-seed1" / "time_split.json";
+  std::ofstream(split) << "{\"revisit_by_place_m\": 7.5, \"uses\": {\"new\": {\"time_s\": 40}, \"revisit\": "
+                          "{\"time_s\": 30}, \"turn\": {\"time_s\": 10}, \"hover\": {\"time_s\": 0}, "
+                          "\"end_game\": {\"time_s\": 20}}}\n";
+  const std::string md = bench_markdown(load_bench_runs(root));
+  // Differences -10 and -10 s; relative -50 % and -25 %: mean -37.5, sd 17.68, t(1) 12.706.
+  EXPECT_NE(md.find("| generated (2 worlds) | dep | Time_r | 2 | 2 / 0 / 0 | -10.00 | [-10.00, -10.00] | -37.5 | "
+                    "[-196.3, 121.3] |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| generated-s1-a50-r1 | dep | 1 | 40.0 | 30.0 | 10.0 | 0.0 | 20.0 | 100.0 | 7.5 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| generated (2 worlds) | dep | 1 | 40.0 |"), std::string::npos) << md;
+}
+
 TEST(BenchReport, EveryPlannerIsDividedByTheOracleAndTheEndGameIsTabled) {
   const std::string root = test::temp_dir("bench_report_oracle");
   // oracle: Time_r 10, Time_95 20, distance 2 x 50 = 100 m. dep: Time_r 30, Time_95 50 (the mean of

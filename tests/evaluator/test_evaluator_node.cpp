@@ -89,10 +89,19 @@ TEST_F(EvaluatorNodeTest, LockstepRunEndsAtThePlannersDoneWithTheFolderComplete)
   EXPECT_EQ(s.collisions, 1);
   EXPECT_EQ(r.state, runtime::NodeState::kDone);
 
-  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "coverage.png", "map.png", "map.bt"}) {
+  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "coverage.png", "map.png", "map.bt",
+                        "time_split.json", "time_split.png"}) {
     EXPECT_TRUE(fs::is_regular_file(fs::path(r.dir) / f)) << f;
   }
-  EXPECT_EQ(r.written.size(), 6u);
+  EXPECT_EQ(r.written.size(), 8u);
+  {
+    // The split accounts for every second up to Time_f.
+    const YAML::Node split = YAML::LoadFile(r.dir + "/time_split.json");
+    double total = 0;
+    for (const auto& use : split["uses"]) total += use.second["time_s"].as<double>();
+    EXPECT_NEAR(total, split["time_f_s"].as<double>(), 1e-6);
+    EXPECT_NEAR(split["time_f_s"].as<double>(), 5.5, 1e-9);
+  }
   {
     std::ifstream bt(r.dir + "/map.bt");
     std::string first;

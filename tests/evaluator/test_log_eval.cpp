@@ -100,6 +100,7 @@ TEST_F(LogEvalTest, SameFiguresAsTheLiveLockstepEvaluator) {
   EXPECT_GT(a.covered_voxels, 0);
   EXPECT_EQ(a.time_r_s, b.time_r_s);
   EXPECT_DOUBLE_EQ(a.distance_m, b.distance_m);
+  EXPECT_EQ(a.time_split.to_json(), b.time_split.to_json()) << "the split of a run and of its log agree";
   EXPECT_EQ(a.collisions, 1);
   EXPECT_EQ(a.collisions, b.collisions);
   EXPECT_EQ(a.info.planner, "test-planner");
@@ -119,8 +120,9 @@ TEST_F(LogEvalTest, SameFiguresAsTheLiveLockstepEvaluator) {
 
   const std::string out = dir_ + "/folder";
   const auto written = ev.write_folder(out);
-  EXPECT_EQ(written.size(), 5u);
+  EXPECT_EQ(written.size(), 7u);
   EXPECT_TRUE(fs::is_regular_file(out + "/map.png"));
+  EXPECT_TRUE(fs::is_regular_file(out + "/time_split.png"));
   EXPECT_EQ(YAML::LoadFile(out + "/metrics.json")["source"].as<std::string>(), "log");
 }
 

@@ -100,8 +100,8 @@ TEST(RunFolder, WritesTheFilesAndCoverageCsvReadsBack) {
   const std::string dir = test::temp_dir("folder") + "/a/b";
   const RunSummary s = example(true);
   const auto written = write_run_metrics(dir, s);
-  ASSERT_EQ(written.size(), 4u);
-  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "coverage.png"}) {
+  ASSERT_EQ(written.size(), 5u);
+  for (const char* f : {"metrics.json", "metrics.csv", "coverage.csv", "time_split.json", "coverage.png"}) {
     EXPECT_TRUE(fs::is_regular_file(fs::path(dir) / f)) << f;
     EXPECT_GT(fs::file_size(fs::path(dir) / f), 20u) << f;
   }

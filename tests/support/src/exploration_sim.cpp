@@ -14,11 +14,17 @@ ExplorationSim::ExplorationSim(const SyntheticWorld& world, ExplorationPlanner& 
     : world_(world), planner_(planner), options_(options), known_(world.resolution()) {
   pose_.position = world.start();
   pose_.yaw = 0.0;
-  if (options_.semantic_weight > 0) {
+  if (options_.semantic_weight > 0 || options_.region_params) {
     const map::KeyMath km(world.resolution());
-    for (const Box& b : world.objects()) {
+    for (size_t i = 0; i < world.objects().size(); ++i) {
+      const Box& b = world.objects()[i];
       Object o;
       o.centre = 0.5 * (b.min + b.max);
+      o.class_id = world.object_classes()[i];
+      o.weight = options_.semantic_weight;
+      o.radius = options_.semantic_radius;
+      if (options_.region_params && !options_.region_params(o.class_id, b.max - b.min, &o.weight, &o.radius))
+        continue;
       const map::VoxelKey lo = km.key(b.min), hi = km.key(b.max);
       for (int32_t z = lo.z; z <= hi.z; ++z)
         for (int32_t y = lo.y; y <= hi.y; ++y)
@@ -53,8 +59,9 @@ void ExplorationSim::update_regions(double t, ExplorationSimResult& r) {
     SemanticRegion s;
     s.id = static_cast<int64_t>(i);
     s.centroid = o.centre;
-    s.weight = options_.semantic_weight;
-    s.radius = options_.semantic_radius;
+    s.class_id = o.class_id;
+    s.weight = o.weight;
+    s.radius = o.radius;
     s.active = !o.completed;
     regions.push_back(s);
   }

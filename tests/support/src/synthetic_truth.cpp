@@ -53,6 +53,10 @@ bool SyntheticTruth::target(const VoxelKey& k) const { return inside(k) && targe
 
 double SyntheticTruth::coverage(const map::StateGrid& known) const {
   if (count_ == 0) return 0.0;
+  return static_cast<double>(covered(known)) / static_cast<double>(count_);
+}
+
+int64_t SyntheticTruth::covered(const map::StateGrid& known) const {
   int64_t seen = 0;
   map::StateGrid::Reader r = known.reader();
   for (int32_t z = lo_.z; z < lo_.z + dims_.z; ++z)
@@ -61,7 +65,7 @@ double SyntheticTruth::coverage(const map::StateGrid& known) const {
         const VoxelKey k{x, y, z};
         if (target_[index(k)] && r.state(k) != map::VoxelState::kUnknown) ++seen;
       }
-  return static_cast<double>(seen) / static_cast<double>(count_);
+  return seen;
 }
 
 }  // namespace semx::planner

@@ -15,7 +15,9 @@
 #include <limits>
 #include <unordered_map>
 
+#include "semx/core/angles.hpp"
 #include "semx/evaluator/map_picture.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
 #include "semx/runtime/channels.hpp"
 
@@ -59,7 +61,9 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
       [this](const semx::odometry_t& m) {
         note_wall();
         message_time(m.utime);
-        evaluation_.on_odometry(m.utime, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]));
+        evaluation_.on_odometry(
+            m.utime, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]),
+            core::yaw_of_quaternion(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]));
       },
       [](const semx::odometry_t& m) { return finite3(m.position); });
   node_.subscribe<semx::sim_event_t>(ch::SIM_EVENT, [this](const semx::sim_event_t& m) {
@@ -240,6 +244,9 @@ void EvaluatorNode::write_folder() {
                     })
         .write_png(png);
     written_.push_back(png);
+    const std::string split_png = (std::filesystem::path(options_.out_dir) / "time_split.png").string();
+    time_split_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.time_split, "where the time went: " + title).write_png(split_png);
+    written_.push_back(split_png);
     const std::string bt = (std::filesystem::path(options_.out_dir) / "map.bt").string();
     write_octomap_bt(grid, bt);
     written_.push_back(bt);

@@ -13,7 +13,9 @@
 #include <limits>
 
 #include "map_messages.hpp"
+#include "semx/core/angles.hpp"
 #include "semx/evaluator/map_picture.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_schema.hpp"
@@ -268,7 +270,9 @@ void LogEvaluator::run() {
       }
       observe(odometry.utime);
       ev.on_odometry(odometry.utime,
-                     Eigen::Vector3d(odometry.position[0], odometry.position[1], odometry.position[2]));
+                     Eigen::Vector3d(odometry.position[0], odometry.position[1], odometry.position[2]),
+                     core::yaw_of_quaternion(odometry.orientation[0], odometry.orientation[1],
+                                             odometry.orientation[2], odometry.orientation[3]));
     } else if (c == ch::SIM_EVENT) {
       semx::sim_event_t event{};
       if (!decode_event(*e, n, event, why)) {
@@ -306,6 +310,9 @@ std::vector<std::string> LogEvaluator::write_folder(const std::string& dir) cons
   run_map_picture(grid(), evaluation_->world(), &evaluation_->ground_truth(), s.trajectory, title)
       .write_png(png);
   written.push_back(png);
+  const std::string split_png = (fs::path(dir) / "time_split.png").string();
+  time_split_picture(grid(), evaluation_->world(), &evaluation_->ground_truth(), s.time_split, "where the time went: " + title).write_png(split_png);
+  written.push_back(split_png);
   return written;
 }
 

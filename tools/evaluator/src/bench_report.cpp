@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // The paper's rows, then the references: the FUEL-class baseline and the known-map oracle.
-const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "fuel", "oracle"};
+const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "semantic-room", "fuel", "oracle"};
 // The planner every other row is divided by in the "× oracle" table.
 const char* const kOraclePlanner = "oracle";
 
@@ -126,30 +126,52 @@ double t975(int df) {
   return df < 1 ? 0.0 : df <= 30 ? table[df - 1] : 1.960;
 }
 
-// A time (Time_r, Time_o) seed by seed: the seeds both planners ran and both reached its
-// threshold in, and of those how many ours reached sooner, at the same time (within 0.05 s: the same flight
-// to the threshold) or later, with the paired mean difference and its 95 % interval (Student's t over the
-// seeds). A margin of the means says which mean is lower; this says whether the seeds could tell.
-std::string paired_row(const Group& ours, const Group& theirs, std::optional<double> BenchRun::*field) {
-  std::vector<double> d;
+std::string signed_fmt(double v, int decimals) { return (v >= 0 ? "+" : "") + fmt(v, decimals); }
+
+// The mean of `d` and its 95 % interval (Student's t), as "[lo, hi]" ("–" for fewer than 2).
+std::string interval_of(const Stat& s, int decimals) {
+  if (s.n < 2) return "–";
+  const double h = t975(s.n - 1) * s.std / std::sqrt(static_cast<double>(s.n));
+  return "[" + fmt(s.mean - h, decimals) + ", " + fmt(s.mean + h, decimals) + "]";
+}
+
+// A time (Time_r, Time_95, Time_o) run by run: the pairs (same world and seed) in which both
+// planners reached its threshold, how many ours reached sooner, at the same time (within 0.05 s:
+// the same flight to the threshold) or later, the paired mean difference with its 95 % interval
+// (Student's t over the pairs), and the mean relative difference (ours / theirs - 1) with its
+// interval. A margin of the means says which mean is lower; this says whether the runs could tell.
+std::string paired_cells(const std::vector<std::pair<double, double>>& pairs) {
+  std::vector<double> d, rel;
   int sooner = 0, same = 0, later = 0;
+  for (const auto& [a, b] : pairs) {
+    const double x = a - b;
+    d.push_back(x);
+    if (b > 0) rel.push_back(100.0 * x / b);
+    (x < -0.05 ? sooner : x > 0.05 ? later : same)++;
+  }
+  if (d.empty()) return "0 | – | – | – | – | – |";
+  const Stat s = stat_of(d), r = stat_of(rel);
+  return std::to_string(s.n) + " | " + std::to_string(sooner) + " / " + std::to_string(same) + " / " +
+         std::to_string(later) + " | " + signed_fmt(s.mean, 2) + " | " + interval_of(s, 2) + " | " +
+         (r.n ? signed_fmt(r.mean, 1) : std::string("–")) + " | " + interval_of(r, 1) + " |";
+}
+
+std::vector<std::pair<double, double>> pairs_of(const Group& ours, const Group& theirs,
+                                                std::optional<double> BenchRun::*field) {
+  std::vector<std::pair<double, double>> pairs;
   for (const BenchRun* a : ours.runs)
     for (const BenchRun* b : theirs.runs) {
-      if (a->seed != b->seed || !(a->*field) || !(b->*field)) continue;
-      const double x = *(a->*field) - *(b->*field);
-      d.push_back(x);
-      (x < -0.05 ? sooner : x > 0.05 ? later : same)++;
+      if (a->world != b->world || a->seed != b->seed || !(a->*field) || !(b->*field)) continue;
+      pairs.emplace_back(*(a->*field), *(b->*field));
     }
-  if (d.empty()) return "0 | – | – | – |";
-  const Stat s = stat_of(d);
-  std::string interval = "–";
-  if (s.n > 1) {
-    const double h = t975(s.n - 1) * s.std / std::sqrt(static_cast<double>(s.n));
-    interval = "[" + fmt(s.mean - h, 2) + ", " + fmt(s.mean + h, 2) + "]";
-  }
-  return std::to_string(s.n) + " | " + std::to_string(sooner) + " / " + std::to_string(same) + " / " +
-         std::to_string(later) + " | " + (s.mean >= 0 ? "+" : "") + fmt(s.mean, 2) + " | " + interval + " |";
+  return pairs;
 }
+
+std::string paired_row(const Group& ours, const Group& theirs, std::optional<double> BenchRun::*field) {
+  return paired_cells(pairs_of(ours, theirs, field));
+}
+
+bool is_generated(const std::string& world) { return world.rfind(kGeneratedPrefix, 0) == 0; }
 }  // namespace
 
 Stat stat_of(const std::vector<double>& values) {
@@ -203,6 +225,17 @@ BenchRun load_bench_run(const std::string& dir) {
   if (m["object_coverage_pct"] && !m["object_coverage_pct"].IsNull())
     r.object_coverage_pct = number_of(m, "object_coverage_pct", file);
 
+  const std::string split_file = (fs::path(dir) / "time_split.json").string();
+  if (fs::exists(split_file)) {
+    try {
+      const YAML::Node t = YAML::LoadFile(split_file);
+      for (const char* use : {"new", "revisit", "turn", "hover", "end_game"})
+        r.split_s.push_back(t["uses"][use]["time_s"].as<double>());
+      r.revisit_by_place_m = t["revisit_by_place_m"].as<double>();
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(split_file + ": " + e.what());
+    }
+  }
   const std::string csv = (fs::path(dir) / "coverage.csv").string();
   std::ifstream in(csv);
   if (in) {
@@ -390,15 +423,74 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
      << " reached it sooner / at the same time (±0.05 s) / later, the mean of its time minus the baseline's, "
         "and that mean's 95 % interval (Student's t over the seeds; an interval across 0: these seeds "
         "do not tell the two apart).\n\n"
-     << "| Env. | vs | time | seeds | sooner / same / later | mean difference (s) | 95 % interval (s) |\n"
-     << "|---|---|---|---|---|---|---|\n";
+     << "| Env. | vs | time | pairs | sooner / same / later | mean difference (s) | 95 % interval (s) | "
+        "mean relative difference (%) | 95 % interval (%) |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  const std::vector<std::pair<const char*, std::optional<double> BenchRun::*>> times = {
+      {"Time_r", &BenchRun::time_r_s}, {"Time_95", &BenchRun::time_95_s}, {"Time_o", &BenchRun::time_o_s}};
+  // The generated worlds pooled: each run paired with the baseline's of the same world and seed.
+  std::map<std::string, std::pair<Group, Group>> pooled;
+  std::set<std::string> pooled_worlds;
   for_each_baseline(runs, o,
                     [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
-                      md << "| " << w << " | " << p << " | Time_r | "
-                         << paired_row(ours, theirs, &BenchRun::time_r_s) << "\n"
-                         << "| " << w << " | " << p << " | Time_o | "
-                         << paired_row(ours, theirs, &BenchRun::time_o_s) << "\n";
+                      for (const auto& [name, field] : times)
+                        md << "| " << w << " | " << p << " | " << name << " | "
+                           << paired_row(ours, theirs, field) << "\n";
+                      if (!is_generated(w)) return;
+                      pooled_worlds.insert(w);
+                      auto& [po, pt] = pooled[p];
+                      po.runs.insert(po.runs.end(), ours.runs.begin(), ours.runs.end());
+                      pt.runs.insert(pt.runs.end(), theirs.runs.begin(), theirs.runs.end());
                     });
+  for (const auto& [p, groups] : pooled) {
+    const std::string w = std::string(kGeneratedPrefix) + " (" + std::to_string(pooled_worlds.size()) + " worlds)";
+    for (const auto& [name, field] : times)
+      md << "| " << w << " | " << p << " | " << name << " | " << paired_row(groups.first, groups.second, field)
+         << "\n";
+  }
+
+  // Where the time went (time_split.json; core/time_split.hpp), mean seconds per run.
+  bool any_split = false;
+  for (const auto& r : runs) any_split |= !r.split_s.empty();
+  if (any_split) {
+    md << "\n### Where the time went (time_split.json), mean s per run\n\n"
+       << "new: flying while the map grows ≥ 0.25 m³/s; revisit: flying while it grows less (through mapped "
+          "space); turn: turning in place; hover: neither; end game: after the map settled. By place: metres "
+          "flown within 1 m of where the vehicle was 10 s or more before.\n\n"
+       << "| Env. | Algorithm | runs | new | revisit | turn | hover | end game | Time_f | revisit by place (m) |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|\n";
+    auto split_row = [&](const std::string& w, const std::string& p, const std::vector<const BenchRun*>& g) {
+      std::vector<std::vector<double>> v(5);
+      std::vector<double> tf, place;
+      for (const auto* r : g) {
+        if (r->split_s.size() != 5) continue;
+        for (size_t i = 0; i < 5; ++i) v[i].push_back(r->split_s[i]);
+        tf.push_back(r->time_f_s);
+        place.push_back(r->revisit_by_place_m);
+      }
+      if (tf.empty()) return;
+      md << "| " << w << " | " << p << " | " << tf.size();
+      for (const auto& x : v) md << " | " << fmt(stat_of(x).mean, 1);
+      md << " | " << fmt(stat_of(tf).mean, 1) << " | " << fmt(stat_of(place).mean, 1) << " |\n";
+    };
+    std::map<std::string, std::vector<const BenchRun*>> generated;
+    std::set<std::string> generated_worlds;
+    for (const auto& w : worlds) {
+      std::vector<const BenchRun*> here;
+      for (const auto& r : runs)
+        if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+      for (const auto& p : planners_of(here)) {
+        const Group g = select(runs, w, p, o.comparison_samples);
+        split_row(w, p, g.runs);
+        if (is_generated(w)) {
+          generated_worlds.insert(w);
+          generated[p].insert(generated[p].end(), g.runs.begin(), g.runs.end());
+        }
+      }
+    }
+    for (const auto& [p, g] : generated)
+      split_row(std::string(kGeneratedPrefix) + " (" + std::to_string(generated_worlds.size()) + " worlds)", p, g);
+  }
   double wall = 0, sim = 0;
   for (const auto& r : runs) {
     wall += r.wall_s;

@@ -34,6 +34,7 @@ bool Evaluation::ensure_resolution(double resolution) {
 
 void Evaluation::note_coverage(int64_t utime) {
   metrics_.on_coverage(utime, tracker_->covered(), tracker_->target_count());
+  if (!finished()) time_split_.on_covered(static_cast<double>(utime) * 1e-6, tracker_->covered());
   metrics_.on_object_coverage(utime, tracker_->object_covered(), tracker_->object_target_count());
 }
 
@@ -58,7 +59,8 @@ void Evaluation::on_map_reset(const map::StateGrid& grid, int64_t utime, int64_t
   note_coverage(utime);
 }
 
-void Evaluation::on_odometry(int64_t utime, const Eigen::Vector3d& position) {
+void Evaluation::on_odometry(int64_t utime, const Eigen::Vector3d& position, double yaw) {
+  if (!finished()) time_split_.on_pose(static_cast<double>(utime) * 1e-6, position, yaw);
   metrics_.on_odometry(utime, position);
 }
 
@@ -139,6 +141,9 @@ RunSummary Evaluation::summary() const {
   s.map_seq = map_seq_;
   s.coverage = metrics_.samples();
   s.trajectory = metrics_.trajectory();
+  const double res = tracker_->resolution();
+  // A run whose coverage never settled (no map) has no end game.
+  s.time_split = time_split_.finish(s.time_f_s, s.time_settled_s.value_or(s.time_f_s), res * res * res);
   return s;
 }
 

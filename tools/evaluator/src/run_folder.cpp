@@ -220,6 +220,7 @@ std::vector<std::string> write_run_metrics(const std::string& dir, const RunSumm
   text("metrics.json", metrics_json(s));
   text("metrics.csv", metrics_csv_header() + metrics_csv_row(s));
   text("coverage.csv", coverage_csv(s));
+  text("time_split.json", s.time_split.to_json());
   CoveragePlotOptions po;
   po.title = "coverage over time: " + (s.info.world.empty() ? std::string("run") : s.info.world) +
              (s.info.planner.empty() ? "" : ", " + s.info.planner);
@@ -266,6 +267,15 @@ std::string format_metrics_table(const RunSummary& s) {
                      " surface voxels of furniture)");
   row(to.c_str(), s.time_o_s ? fmt("%.2f s", *s.time_o_s) : std::string("N/A (never reached)"));
   row("collisions", std::to_string(s.collisions));
+  if (s.time_split.time_f > 0) {
+    std::string split;
+    for (int i = 0; i < core::kTimeUses; ++i) {
+      const auto u = static_cast<core::TimeUse>(i);
+      split += std::string(i ? ", " : "") + core::to_string(u) +
+               fmt(" %.0f s", s.time_split.time_s[static_cast<size_t>(i)]) + fmt(" (%.0f %%)", 100.0 * s.time_split.share(u));
+    }
+    row("time split", split);
+  }
   row("wall", fmt("%.1f s", s.wall_s) +
                   (s.realtime_factor > 0 ? fmt("  (%.1fx real time)", s.realtime_factor) : std::string()));
   return o.str();

@@ -97,8 +97,14 @@ class DepStrategy : public Strategy {
   // `unreachable` (optional) counts the nodes with gain >= min_gain the root cannot reach. With
   // `sweep` a node is scored at the yaw whose turn from the vehicle's heading, counting what it
   // sweeps, scores best (GainConfig::sweep); otherwise at its best window.
+  // `tier` (optional): a node of a higher tier outranks every node of a lower one (the ordering
+  // rules of semantic_room_strategy.hpp); it is called after the search, so last_search() holds
+  // this cycle's paths. Without it, cost.local_first decides the tiers.
+  using TierFn = std::function<int(int64_t id)>;
   Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                   int64_t* unreachable = nullptr, bool sweep = false);
+                   int64_t* unreachable = nullptr, bool sweep = false, const TierFn* tier = nullptr);
+  // One cycle (plan()) with goals ranked by `tier` first (nullptr: plan() itself).
+  PlanOutcome plan_with(PlanContext& ctx, const TierFn* tier);
   // The paper's score (G + R_sem) / T_path (travel_cost.hpp).
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);
@@ -106,6 +112,8 @@ class DepStrategy : public Strategy {
   const Roadmap& graph() const { return graph_; }
   Roadmap& graph() { return graph_; }
   int64_t root() const { return root_; }
+  const PlannerConfig& config() const { return config_; }
+  const Roadmap::Search& last_search() const { return search_; }
   CollisionChecker& checker() { return checker_; }
   GainEvaluator& gains() { return gains_; }
 

@@ -22,6 +22,9 @@ enum class PlannerKind {
   kNbv,          // receding-horizon RRT next-best-view (Bircher 2016)
   kAep,          // RRT* with cached gains and frontier fallback (Selin 2019)
   kFuel,         // frontier clusters, a global tour over their viewpoints (Zhou 2021)
+  // DEP's roadmap with what the semantic map says about rooms: a door region is a room's
+  // boundary, and the rules of RoomConfig order the goals by room (semantic_room_strategy.hpp).
+  kSemanticRoom,
   // NOT an exploration method: reads the world's ground truth and flies a precomputed tour of
   // viewpoints that sees it (oracle_strategy.hpp), the physical-limit reference of the bench.
   kOracle,
@@ -159,6 +162,30 @@ struct RewardConfig {
   // field of view at the node's yaw (docs/planner.md, "Semantic reward"). false: the paper's
   // Eq. 6, every region within r_i whichever way the node looks.
   bool in_view = false;
+};
+
+// semantic-room (semantic_room_strategy.hpp; docs/planner.md, "semantic-room"): DEP whose goals
+// are ordered by the rooms the semantic map shows. Rooms: the roadmap split at its doorways,
+// i.e. at the nodes within door_radius of a door region (semantics) and, with passages_bound, at
+// the passage nodes DEP centres in gaps too narrow for a node (geometry).
+struct RoomConfig {
+  double door_radius = 1.0;  // m, horizontal: nodes this near a door region's centroid stand in its doorway
+  bool passages_bound = true;
+  // Weighted voxels: while a node of the vehicle's room has at least this gain, nodes beyond its
+  // doorways are not chosen (finish the room before passing a door); 0: off.
+  double finish_gain = 3000.0;
+  // A global order of rooms: the rooms with a node of finish_gain are visited in the order of the
+  // shortest open tour through them from the vehicle (roadmap distances between each room's best
+  // node; tour_solver.hpp), and only the first room's nodes of finish_gain are goals while any
+  // is left. false: the vehicle's own room first, then DEP's ranking.
+  bool tour = false;
+  // What "gain left in the room" counts: false, G itself; true, only its frontier and surface
+  // voxels (w_f U_f + w_s U_s at the best window). G counts unknown space behind walls too (unknown
+  // does not occlude), so next to an unexplored room a room's nodes keep a large G that staying
+  // in the room never lowers; its frontier and surface voxels are what looking around it shows.
+  bool boundary_gain = false;
+  // The paper's Eq. 6 reward on top (as semantic-dep); false: G / T_path alone.
+  bool eq6_reward = true;
 };
 
 // The main loop: when to replan, when to give up.
@@ -342,7 +369,7 @@ struct OracleConfig {
 };
 
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -357,6 +384,7 @@ struct PlannerConfig {
   AepConfig aep;
   FuelConfig fuel;
   OracleConfig oracle;
+  RoomConfig room;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };

@@ -26,6 +26,11 @@ struct Region {
   bool active = true;  // false once fully observed: rewards nothing
 };
 
+// w_i and r_i of an object of class `cls` whose box has `extent` (make_regions' rule; the planner's
+// closed loop emulates regions with it).
+double region_weight(const RegionConfig& config, runtime::SemanticClass cls);
+double region_radius(const RegionConfig& config, runtime::SemanticClass cls, const Eigen::Vector3d& extent);
+
 // The regions of the promoted tracks of enabled classes, ordered by id.
 // w = weight_scale * classes[l].weight, r = classes[l].radius + radius_extent_gain * |extent| / 2.
 std::vector<Region> make_regions(const std::vector<Track>& tracks, const RegionConfig& config);

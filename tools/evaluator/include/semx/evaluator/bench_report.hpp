@@ -28,6 +28,10 @@ struct BenchRun {
   bool valid = true;           // metrics.json "valid" (a run folder from before it: true)
   std::string invalid_reason;  // why not
   std::vector<std::pair<double, double>> coverage;  // (t s, %)
+  // time_split.json (empty when the folder has none): seconds of new, revisit, turn, hover and
+  // end game, and the metres flown over ground flown before.
+  std::vector<double> split_s;
+  double revisit_by_place_m = 0;
 };
 
 // Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
@@ -47,7 +51,12 @@ struct BenchReportOptions {
   double threshold_pct = 85.0;
 };
 
-// Markdown: (only the valid runs; those that are not are listed under the tables) the sweep table, the comparison table (with Time_95, the end game and Time_o, the
+// Worlds whose name starts with this (semx-world gen's names) are also compared as one set: the
+// runs paired by world and seed, differences relative to the baseline's run.
+inline constexpr const char* kGeneratedPrefix = "generated";
+
+// Markdown (only the valid runs; those that are not are listed under the tables): the sweep
+// table, the comparison table (with Time_95, the end game and Time_o, the
 // objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
 // the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
 // baseline (Time_f, Time_r, Time_o, Distance, in %), each world in the order the runs name them.

@@ -14,11 +14,13 @@
 // on_episode_end() ends it at once. Events after the end are ignored.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "semx/core/time_split.hpp"
 #include "semx/evaluator/coverage_tracker.hpp"
 #include "semx/evaluator/run_metrics.hpp"
 #include "semx/evaluator/run_summary.hpp"
@@ -50,7 +52,8 @@ class Evaluation {
   void on_map_reset(const map::StateGrid& grid, int64_t utime, int64_t seq = -1);
 
   // ---- vehicle, planner, simulator ----
-  void on_odometry(int64_t utime, const Eigen::Vector3d& position);
+  // `yaw` (rad) for the time split's turns; not finite: no turn is counted.
+  void on_odometry(int64_t utime, const Eigen::Vector3d& position, double yaw = std::nan(""));
   void on_collision(int64_t utime, int64_t running_count);
   void on_planner_status(int64_t utime, const std::string& planner, PlannerState state,
                          const std::string& reason = "");
@@ -94,6 +97,7 @@ class Evaluation {
   std::shared_ptr<const simulator::GroundTruth> gt_;
   std::unique_ptr<CoverageTracker> tracker_;
   RunMetrics metrics_;
+  core::TimeSplit time_split_;
   std::string planner_;
   std::string planner_reason_;
   int64_t map_deltas_ = 0;

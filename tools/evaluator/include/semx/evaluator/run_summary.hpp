@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/time_split.hpp"
 #include "semx/evaluator/run_metrics.hpp"
 
 namespace semx::evaluator {
@@ -57,6 +58,8 @@ struct RunSummary {
   int64_t map_seq = 0;  // last map sequence number applied
   std::vector<CoverageSample> coverage;
   std::vector<Eigen::Vector3d> trajectory;
+  // Where the time went: new space, revisits, turns, hover, end game (time_split.json/.png).
+  core::TimeSplitResult time_split;
 };
 
 }  // namespace semx::evaluator

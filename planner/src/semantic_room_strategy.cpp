@@ -1,0 +1,147 @@
+#include "semx/planner/semantic_room_strategy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include "semx/planner/tour_solver.hpp"
+#include "semx/runtime/semantic_classes.hpp"
+
+namespace semx::planner {
+
+SemanticRoomStrategy::SemanticRoomStrategy(const PlannerConfig& config)
+    : DepStrategy(config, config.room.eq6_reward), rules_(config.room) {}
+
+bool SemanticRoomStrategy::doorway(const PlanContext& ctx, int64_t id) const {
+  const RoadmapNode& n = graph().node(id);
+  if (rules_.passages_bound && n.passage) return true;
+  if (!ctx.regions || !(rules_.door_radius > 0)) return false;
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  const double r2 = rules_.door_radius * rules_.door_radius;
+  for (const SemanticRegion& s : *ctx.regions) {
+    // A door stays a doorway once its leaf is fully observed (active only says the leaf was seen).
+    if (s.class_id != door || !s.centroid.allFinite()) continue;
+    if ((n.position - s.centroid).head<2>().squaredNorm() <= r2) return true;
+  }
+  return false;
+}
+
+void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
+  const Roadmap& g = graph();
+  constexpr int kUnlabelled = -2;
+  room_.assign(g.slots().size(), -1);
+  const Roadmap::Search& reach = last_search();
+  for (const RoadmapNode& n : g.slots()) {
+    if (n.alive && reach.reached(n.id) && !doorway(ctx, n.id)) room_[static_cast<size_t>(n.id)] = kUnlabelled;
+  }
+  int rooms = 0;
+  auto flood = [&](int64_t seed) {
+    std::deque<int64_t> open{seed};
+    room_[static_cast<size_t>(seed)] = rooms;
+    while (!open.empty()) {
+      const int64_t id = open.front();
+      open.pop_front();
+      for (const RoadmapEdge& e : g.node(id).edges) {
+        int& label = room_[static_cast<size_t>(e.to)];
+        if (label != kUnlabelled) continue;
+        label = rooms;
+        open.push_back(e.to);
+      }
+    }
+    ++rooms;
+  };
+  // The vehicle's room is room 0 (none when it stands in a doorway).
+  const bool in_room = root() >= 0 && room_[static_cast<size_t>(root())] == kUnlabelled;
+  if (in_room) flood(root());
+  for (const RoadmapNode& n : g.slots()) {
+    if (room_[static_cast<size_t>(n.id)] == kUnlabelled) flood(n.id);
+  }
+  target_ = -1;
+  if (!(rules_.finish_gain > 0)) return;
+  if (!rules_.tour) {
+    target_ = in_room ? 0 : -1;
+    return;
+  }
+  choose_target(ctx, rooms);
+}
+
+void SemanticRoomStrategy::choose_target(PlanContext& ctx, int rooms) {
+  // Each room's best node of finish_gain, its gain fresh (a stale gain only bounds it from above).
+  std::vector<int64_t> best(static_cast<size_t>(rooms), -1);
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::fill(best.begin(), best.end(), -1);
+    for (const RoadmapNode& n : graph().slots()) {
+      const int r = room_[static_cast<size_t>(n.id)];
+      if (r < 0 || n.passage || n.blacklisted_until >= ctx.cycle || !n.gain.valid) continue;
+      if (room_gain(n) < rules_.finish_gain) continue;
+      int64_t& b = best[static_cast<size_t>(r)];
+      if (b < 0 || room_gain(n) > room_gain(graph().node(b))) b = n.id;
+    }
+    for (int64_t b : best) {
+      if (b >= 0 && graph().node(b).gain_stale) {
+        evaluate_gain(ctx, b);
+        changed = true;
+      }
+    }
+  }
+  std::vector<int> candidates;  // rooms, in the tour's node order 1..m
+  for (int r = 0; r < rooms; ++r)
+    if (best[static_cast<size_t>(r)] >= 0) candidates.push_back(r);
+  if (candidates.size() <= 1) {
+    target_ = candidates.empty() ? -1 : candidates.front();
+    return;
+  }
+  // Travel between the rooms' best nodes along the roadmap; from the vehicle, this cycle's search.
+  const int m = static_cast<int>(candidates.size());
+  TourProblem p;
+  p.n = m + 1;
+  p.cost.assign(static_cast<size_t>(p.n * p.n), 0.0);
+  const Roadmap::Search& from_root = last_search();
+  for (int j = 0; j < m; ++j)
+    p.cost[static_cast<size_t>(j + 1)] = from_root.distance[static_cast<size_t>(best[static_cast<size_t>(candidates[j])])];
+  for (int i = 0; i < m; ++i) {
+    const Roadmap::Search s = graph().shortest_paths(best[static_cast<size_t>(candidates[i])]);
+    ctx.counters->search_settled += s.settled;
+    for (int j = 0; j < m; ++j) {
+      const double d = s.distance[static_cast<size_t>(best[static_cast<size_t>(candidates[j])])];
+      p.cost[static_cast<size_t>((i + 1) * p.n + (j + 1))] = std::isfinite(d) ? d : 1e9;
+    }
+  }
+  const Tour t = solve_open_tour(p, 10);
+  target_ = t.order.empty() ? -1 : candidates[static_cast<size_t>(t.order.front() - 1)];
+}
+
+DepStrategy::TierFn SemanticRoomStrategy::tiers(PlanContext& ctx, bool* labelled) {
+  // Asked for after select_goal's search: the rooms are labelled on first use.
+  return [this, &ctx, labelled](int64_t id) {
+    if (!*labelled) {
+      label_rooms(ctx);
+      *labelled = true;
+    }
+    if (target_ < 0 || room_[static_cast<size_t>(id)] != target_) return 0;
+    // Gains are upper bounds until re-evaluated (stale ones come back with their new gain).
+    return room_gain(graph().node(id)) >= rules_.finish_gain ? 1 : 0;
+  };
+}
+
+double SemanticRoomStrategy::room_gain(const RoadmapNode& n) const {
+  if (!rules_.boundary_gain) return n.gain.gain;
+  const GainConfig& g = config().gain;
+  return g.weight_frontier * static_cast<double>(n.gain.counts[1]) +
+         g.weight_surface * static_cast<double>(n.gain.counts[2]);
+}
+
+PlanOutcome SemanticRoomStrategy::plan(PlanContext& ctx) {
+  bool labelled = false;
+  const TierFn tier = tiers(ctx, &labelled);
+  return plan_with(ctx, &tier);
+}
+
+Goal SemanticRoomStrategy::select_goal_by_rooms(PlanContext& ctx, std::string* reason) {
+  bool labelled = false;
+  const TierFn tier = tiers(ctx, &labelled);
+  return select_goal(ctx, paper_score(), reason, nullptr, config().gain.sweep, &tier);
+}
+
+}  // namespace semx::planner

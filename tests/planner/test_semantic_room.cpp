@@ -1,0 +1,131 @@
+// semantic-room's rules on a small synthetic map (semantic_room_strategy.hpp): where each must
+// change DEP's goal, and where it must not.
+#include <gtest/gtest.h>
+
+#include "planner_test_util.hpp"
+#include "semx/core/angles.hpp"
+#include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/semantic_room_strategy.hpp"
+#include "semx/runtime/semantic_classes.hpp"
+
+namespace semx::planner {
+namespace {
+
+// SyntheticWorld::two_rooms (x 0-4 and 4.2-8.2, y 0-4, a 1.2 m doorway at y 1.4-2.6 in the wall
+// at x 4.0-4.2): the first room is known but for a hidden corner (a pocket of unknown voxels),
+// the second only its first 1.5 m. The vehicle stands in the first room; nodes: one by the
+// pocket, one in the doorway, one in the second room looking at its unknown part.
+struct TwoRoomScene {
+  PlannerConfig config = test_config("semantic-room");
+  map::StateGrid grid = map::StateGrid(0.1);
+  FrontierTracker frontiers{1.0};
+  core::SplitMixRng rng{1};
+  std::vector<SemanticRegion> regions;
+  CycleCounters counters;
+  int64_t pocket = -1, doorway = -1, beyond = -1;
+
+  TwoRoomScene() {
+    config.gain.min_gain = 300.0;  // the test rays count fewer voxels than the defaults
+    const SyntheticWorld w = SyntheticWorld::two_rooms();
+    w.reveal(grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
+    fill_m(grid, {0.0, 2.9, 0.0}, {1.0, 4.0, 1.3}, map::VoxelState::kUnknown);
+    frontiers.reset(grid);
+  }
+  // A door leaf standing open into the first room beside the doorway's north jamb.
+  static SemanticRegion door() {
+    SemanticRegion r;
+    r.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
+    r.centroid = Eigen::Vector3d(3.55, 2.65, 1.0);
+    r.weight = 300.0;
+    r.radius = 3.0;
+    return r;
+  }
+  Goal choose(DepStrategy& s) {
+    s.on_map_reset();
+    PlanContext ctx;
+    ctx.grid = &grid;
+    ctx.pose.position = Eigen::Vector3d(2.5, 1.6, 1.2);
+    ctx.pose.yaw = -0.5 * core::kPi;
+    ctx.regions = &regions;
+    ctx.frontiers = &frontiers;
+    ctx.cycle = 1;
+    ctx.rng = &rng;
+    ctx.counters = &counters;
+    ctx.min_gain = config.gain.min_gain;
+    s.process_map_changes(ctx);
+    const int64_t root = s.insert_root(ctx);
+    s.graph().node(root).blacklisted_until = 10;  // the choice is between the three nodes
+    pocket = s.try_insert(ctx, {1.6, 2.4, 1.0});
+    doorway = s.try_insert(ctx, {4.1, 2.0, 1.2});
+    beyond = s.try_insert(ctx, {5.2, 2.0, 1.2});
+    EXPECT_GE(pocket, 0);
+    EXPECT_GE(doorway, 0);
+    EXPECT_GE(beyond, 0);
+    std::string reason;
+    if (auto* room = dynamic_cast<SemanticRoomStrategy*>(&s)) return room->select_goal_by_rooms(ctx, &reason);
+    return s.select_goal(ctx, s.paper_score(), &reason);
+  }
+};
+
+TEST(SemanticRoom, ADoorSplitsTheRoadmapIntoRooms) {
+  TwoRoomScene s;
+  s.regions = {TwoRoomScene::door()};
+  SemanticRoomStrategy room(s.config);
+  s.choose(room);
+  const auto& label = room.room_of();
+  EXPECT_EQ(label[static_cast<size_t>(room.root())], 0);  // the vehicle's room
+  EXPECT_EQ(label[static_cast<size_t>(s.pocket)], 0);
+  EXPECT_EQ(label[static_cast<size_t>(s.doorway)], -1);  // within door_radius of the door
+  EXPECT_EQ(label[static_cast<size_t>(s.beyond)], 1);
+  // Without the door (and without passage nodes: the doorway is wide enough for a node) the
+  // roadmap is one room.
+  TwoRoomScene t;
+  SemanticRoomStrategy open(t.config);
+  t.choose(open);
+  EXPECT_EQ(open.room_of()[static_cast<size_t>(t.beyond)], 0);
+}
+
+// Finish the room before passing a door: DEP flies on to the second room, whose unknown part
+// is worth more per second; semantic-room keeps to the pocket in the vehicle's room first.
+TEST(SemanticRoom, ADoorKeepsTheVehicleInItsRoomWhileTheRoomHasGain) {
+  TwoRoomScene s;
+  s.regions = {TwoRoomScene::door()};
+  DepStrategy dep(s.config, true);
+  const Goal d = s.choose(dep);
+  ASSERT_TRUE(d.valid);
+  EXPECT_NE(d.node, s.pocket) << "the scene is meant to make DEP leave the room";
+  const double pocket_gain = dep.graph().node(s.pocket).gain.gain;
+  ASSERT_GT(pocket_gain, s.config.gain.min_gain);
+
+  s.config.room.finish_gain = 0.5 * pocket_gain;
+  SemanticRoomStrategy room(s.config);
+  const Goal r = s.choose(room);
+  ASSERT_TRUE(r.valid);
+  EXPECT_EQ(r.node, s.pocket);
+}
+
+TEST(SemanticRoom, WithoutADoorOrWithLittleLeftInTheRoomItFliesDepsGoal) {
+  TwoRoomScene base;
+  base.regions = {TwoRoomScene::door()};
+  DepStrategy dep(base.config, true);
+  const Goal d = base.choose(dep);
+  const double pocket_gain = dep.graph().node(base.pocket).gain.gain;
+  // No door seen: one room, DEP's goal.
+  {
+    TwoRoomScene s;
+    s.config.room.finish_gain = 0.5 * pocket_gain;
+    SemanticRoomStrategy room(s.config);
+    EXPECT_EQ(s.choose(room).position, d.position);
+  }
+  // The door seen, but what is left in the room is below finish_gain: DEP's goal.
+  {
+    TwoRoomScene s;
+    s.regions = {TwoRoomScene::door()};
+    s.config.room.finish_gain = 2.0 * pocket_gain;
+    SemanticRoomStrategy room(s.config);
+    EXPECT_EQ(s.choose(room).position, d.position);
+  }
+}
+
+}  // namespace
+}  // namespace semx::planner
