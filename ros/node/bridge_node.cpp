@@ -210,11 +210,13 @@ void BridgeNode::publish_map(int64_t utime) {
   if (ros_.wants(OutTopic::kMap) && utime >= next_map_utime_ && grid.changes() != map_changes_sent_) {
     next_map_utime_ = utime + period_us(config_.rates.map_hz);
     map_changes_sent_ = grid.changes();
-    ros_.send({OutTopic::kMap, voxel_cloud(grid, map::VoxelState::kOccupied, config_.frames.map, time().to_ros_ns(utime))});
+    ros_.send({OutTopic::kMap, voxel_cloud(grid, map::VoxelState::kOccupied, config_.frames.map,
+                                           time().to_ros_ns(utime), config_.rates.map_max_z)});
   }
   if (ros_.wants(OutTopic::kMapFree) && utime >= next_free_utime_) {
     next_free_utime_ = utime + period_us(config_.rates.map_free_hz);
-    ros_.send({OutTopic::kMapFree, voxel_cloud(grid, map::VoxelState::kFree, config_.frames.map, time().to_ros_ns(utime))});
+    ros_.send({OutTopic::kMapFree, voxel_cloud(grid, map::VoxelState::kFree, config_.frames.map,
+                                               time().to_ros_ns(utime), config_.rates.map_max_z)});
   }
 }
 

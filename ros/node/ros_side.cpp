@@ -29,6 +29,13 @@ bool keeps_newest(OutTopic t) {
          t == OutTopic::kRegions;
 }
 
+// Topics whose last message a late subscriber (rviz started after the run, or everyone after the
+// master was replaced) should still get.
+bool latched(OutTopic t) {
+  return t == OutTopic::kMap || t == OutTopic::kRoadmap || t == OutTopic::kRegions || t == OutTopic::kPath ||
+         t == OutTopic::kTrajectory || t == OutTopic::kStatus;
+}
+
 }  // namespace
 
 // roscpp's objects. `handles` is rebuilt on every (re)connection; the rest lives as long as the
@@ -52,6 +59,8 @@ struct RosSide::Ros {
   tf2::BufferCore tf_buffer{::ros::Duration(30.0)};
   std::optional<msg::CameraInfo> camera_info;
   std::deque<Pending> pending;
+  std::map<OutTopic, OutItem> last_latched;  // re-sent after a reconnection
+  bool resend_latched = false;
   std::map<int64_t, int64_t> frame_ids;  // image stamp -> semx frame id (depth and labels pair up)
   int64_t next_frame_id = 1;
   PoseDifferentiator differentiator;
@@ -317,6 +326,7 @@ void RosSide::run() {
       statics_changed_ = true;  // the new master's subscribers need them
       ++counters_.connects;
     }
+    R.resend_latched = true;
     registered = true;
     connected_ = true;
     std::cerr << "semx-ros-bridge: registered with the ROS master " << ::ros::master::getURI() << std::endl;
@@ -389,7 +399,14 @@ void RosSide::run() {
         for (const auto& t : statics) tf.transforms.push_back(to_ros_msg(t));
         R.h.tf_static.publish(tf);
       }
-      for (auto& item : items) (publish(item) ? published : dropped) += 1;
+      if (R.resend_latched && registered) {
+        R.resend_latched = false;
+        for (auto& [topic, item] : R.last_latched) publish(item);
+      }
+      for (auto& item : items) {
+        (publish(item) ? published : dropped) += 1;
+        if (latched(item.topic)) R.last_latched[item.topic] = std::move(item);
+      }
     } else {
       dropped = static_cast<int64_t>(items.size());
     }

@@ -72,6 +72,7 @@ void load(runtime::ConfigMap& m, BridgeConfig& c) {
   r.get("esdf_hz", c.rates.esdf_hz, 0.01, 100.0);
   r.get("trajectory_dt", c.rates.trajectory_dt, 0.01, 10.0);
   r.get("esdf_slice_offset", c.rates.esdf_slice_offset, -10.0, 10.0);
+  r.get("map_max_z", c.rates.map_max_z, -1e6, 1e6);
 
   m.get("camera", c.camera);
   m.get("publish_clock", c.publish_clock);

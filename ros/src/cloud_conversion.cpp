@@ -54,19 +54,21 @@ bool float_offsets(const msg::PointCloud2& cloud, const std::vector<std::string>
 }  // namespace
 
 msg::PointCloud2 voxel_cloud(const map::StateGrid& grid, map::VoxelState state, const std::string& frame,
-                             int64_t stamp_ns) {
+                             int64_t stamp_ns, double max_z) {
+  const double r = grid.resolution();
   std::vector<map::VoxelKey> keys;
   keys.reserve(static_cast<std::size_t>(state == map::VoxelState::kOccupied ? grid.occupied_voxels()
                                                                             : grid.free_voxels()));
   grid.for_each_block([&](const map::VoxelKey& b, const map::VoxelBlock& block) {
     if (block.known == 0) return;
     for (int i = 0; i < map::kBlockVolume; ++i) {
-      if (block.state[static_cast<std::size_t>(i)] == state) keys.push_back(map::voxel_of(b, i));
+      if (block.state[static_cast<std::size_t>(i)] != state) continue;
+      const map::VoxelKey k = map::voxel_of(b, i);
+      if ((k.z + 0.5) * r <= max_z) keys.push_back(k);
     }
   });
   std::sort(keys.begin(), keys.end());
   msg::PointCloud2 c = float_cloud({"x", "y", "z"}, frame, stamp_ns, keys.size());
-  const double r = grid.resolution();
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const std::size_t at = i * c.point_step;
     put(c.data, at, static_cast<float>((keys[i].x + 0.5) * r));

@@ -356,6 +356,15 @@ TEST(RosMap, VoxelCloudsGiveTheirKeysBack) {
     ASSERT_TRUE(voxel_keys(c, 0.1, keys));
     EXPECT_EQ(std::set<map::VoxelKey>(keys.begin(), keys.end()), *expected);
   }
+  // Clipped: only voxels whose centre is at most max_z high.
+  std::vector<map::VoxelKey> low;
+  ASSERT_TRUE(voxel_keys(voxel_cloud(grid, map::VoxelState::kOccupied, "map", 42, 1.0), 0.1, low));
+  std::size_t expected_low = 0;
+  for (const auto& k : occupied) expected_low += (k.z + 0.5) * 0.1 <= 1.0;
+  EXPECT_EQ(low.size(), expected_low);
+  EXPECT_GT(expected_low, 0u);
+  EXPECT_LT(expected_low, occupied.size());
+  for (const auto& k : low) EXPECT_LE(k.z, 9);
   msg::PointCloud2 bad = voxel_cloud(grid, map::VoxelState::kOccupied, "map", 0);
   bad.data.resize(bad.data.size() - 1);
   std::vector<map::VoxelKey> keys;
@@ -632,6 +641,7 @@ TEST(RosConfig, TheShippedYamlIsExactlyTheDefaultsAndErrorsNameTheKey) {
   SAME(rates.esdf_hz);
   SAME(rates.trajectory_dt);
   SAME(rates.esdf_slice_offset);
+  SAME(rates.map_max_z);
   SAME(camera);
   SAME(publish_clock);
   SAME(queue_frames);

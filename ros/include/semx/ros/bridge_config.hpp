@@ -61,6 +61,9 @@ struct BridgeRates {
   double esdf_hz = 2.0;      // ESDF slice
   double trajectory_dt = 0.1;   // s between the trajectory's samples
   double esdf_slice_offset = 0.0;  // m above the vehicle's height
+  // m: the map clouds leave out voxels whose centre is higher (a ceiling hides a room from above,
+  // rviz's default view); a large value keeps every voxel.
+  double map_max_z = 2.0;
 };
 
 struct BridgeConfig {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -15,9 +16,9 @@
 
 namespace semx::rosbridge {
 
-// Every voxel of `grid` in `state`, in ascending key order.
+// Every voxel of `grid` in `state` whose centre is at most `max_z` high, in ascending key order.
 msg::PointCloud2 voxel_cloud(const map::StateGrid& grid, map::VoxelState state, const std::string& frame,
-                             int64_t stamp_ns);
+                             int64_t stamp_ns, double max_z = std::numeric_limits<double>::infinity());
 // The keys of a voxel_cloud (any cloud with float32 x, y, z), at `resolution`. False when the
 // cloud lacks those fields or its sizes disagree.
 bool voxel_keys(const msg::PointCloud2& cloud, double resolution, std::vector<map::VoxelKey>& keys);
