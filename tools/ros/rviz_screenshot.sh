@@ -3,7 +3,7 @@
 #   tools/ros/rviz_screenshot.sh OUT.png [--world env3] [--after S] [-- demo args]
 # Runs ./semx demo --ros (lockstep) in a run folder next to OUT.png, opens rviz on a virtual
 # display once the bridge is up, and grabs the screen S wall seconds later (needs xwd from
-# x11-apps and netpbm's xwdtopnm/pnmtopng). Its own ROS master port and display.
+# x11-apps and netpbm's xwdtopnm, pnmquant, pnmtopng). Its own ROS master port and display.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "${BASH_SOURCE[0]}")")/../.." && pwd)
 png="" world=env3 after=60
@@ -18,7 +18,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -n "$png" ] || { echo "rviz_screenshot: which OUT.png?" >&2; exit 2; }
-for t in Xvfb xwd xwdtopnm pnmtopng rviz; do command -v $t >/dev/null || { echo "rviz_screenshot: $t missing" >&2; exit 2; }; done
+for t in Xvfb xwd xwdtopnm pnmquant pnmtopng rviz; do command -v $t >/dev/null || { echo "rviz_screenshot: $t missing" >&2; exit 2; }; done
 png=$(readlink -f "$png")
 run="${png%.png}-run"
 display=:$((90 + $$ % 9))
@@ -34,5 +34,5 @@ for _ in $(seq 1 120); do grep -q "registered with the ROS master" "$run/logs/ro
 DISPLAY=$display rviz -d "$ROOT/tools/ros/semx.rviz" >"$run-rviz.log" 2>&1 &
 pids+=($!)
 sleep "$after"
-DISPLAY=$display xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng >"$png"
+DISPLAY=$display xwd -root -silent | xwdtopnm 2>/dev/null | pnmquant 256 2>/dev/null | pnmtopng >"$png"
 echo "rviz_screenshot: $png ($(wc -c <"$png") bytes); run folder $run"
