@@ -28,11 +28,11 @@ ros_packages=(
 )
 [ "${SEMX_NO_ROS:-0}" = 1 ] || packages+=("${ros_packages[@]}")
 
+# One dpkg-query for all of them: every ./semx command runs this first.
+installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null | awk '/ install ok installed$/ {print $1}')
 missing=()
 for p in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("$p")
-  fi
+  grep -qxF "$p" <<<"$installed" || missing+=("$p")
 done
 
 if [ ${#missing[@]} -eq 0 ]; then

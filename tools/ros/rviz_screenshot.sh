@@ -24,7 +24,17 @@ run="${png%.png}-run"
 display=:$((90 + $$ % 9))
 export ROS_MASTER_URI=http://localhost:$((11711 + $$ % 200)) ROS_HOME="$run-ros"
 pids=()
-trap 'for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done; sleep 2; for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done' EXIT
+stop_all() {  # the demo stops its bridge and roscore on SIGINT: give it the time
+  for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
+  for _ in $(seq 1 40); do
+    alive=0
+    for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ $alive = 0 ] && return 0
+    sleep 0.5
+  done
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+}
+trap stop_all EXIT
 Xvfb "$display" -screen 0 1400x860x24 >/dev/null 2>&1 &
 pids+=($!)
 "$ROOT/semx" demo --ros --world "$world" --out "$run" --force "${extra[@]}" >"$run.console" 2>&1 &
