@@ -19,11 +19,22 @@ packages=(
   xvfb procps iproute2
 )
 
+# ROS 1 (Debian's Noetic-era packages) for semx-ros-bridge, rosbag and rviz (docs/ros.md); the
+# bridge builds only where they are. SEMX_NO_ROS=1 leaves them out (semx works without them).
+ros_packages=(
+  libroscpp-dev libtf2-ros-dev libtf2-msgs-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev
+  libvisualization-msgs-dev libdiagnostic-msgs-dev
+  ros-core python3-rosbag python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-visualization-msgs
+  python3-diagnostic-msgs python3-tf2-msgs
+  rviz
+)
+[ "${SEMX_NO_ROS:-0}" = 1 ] || packages+=("${ros_packages[@]}")
+
+# One dpkg-query for all of them: every ./semx command runs this first.
+installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null | awk '/ install ok installed$/ {print $1}')
 missing=()
 for p in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("$p")
-  fi
+  grep -qxF "$p" <<<"$installed" || missing+=("$p")
 done
 
 if [ ${#missing[@]} -eq 0 ]; then

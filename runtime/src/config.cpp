@@ -1,8 +1,13 @@
 #include "semx/runtime/config.hpp"
 
+#include <algorithm>
+#include <cerrno>  // program_invocation_short_name
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
+#include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace semx::runtime {
@@ -256,6 +261,99 @@ void ConfigMap::check_unread(const YAML::Node& node, const std::string& path) co
 }
 
 void ConfigMap::finish() const { check_unread(node_, path_); }
+
+void ConfigMap::set_overridden(std::set<std::string> keys, std::string file) {
+  log_->overridden = std::move(keys);
+  log_->file = std::move(file);
+}
+
+void ConfigMap::note(const std::string& key, const std::string& value, bool present) {
+  const std::string k = qualified(key);
+  std::string origin = "default";
+  if (present) origin = log_->overridden.count(k) ? "--set" : (log_->file.empty() ? source_ : log_->file);
+  log_->values.push_back({k, value, origin});
+}
+
+namespace {
+
+std::vector<EffectiveValue>& registry() {
+  static std::vector<EffectiveValue> values;
+  return values;
+}
+
+std::string override_key(const std::string& assignment) { return assignment.substr(0, assignment.find('=')); }
+
+// The value at a dotted path of `root`, if there is one.
+std::optional<YAML::Node> at_path(const YAML::Node& root, const std::string& key) {
+  YAML::Node n;
+  n.reset(root);  // reset() rebinds the handle; assignment would write into the document
+  std::stringstream ss(key);
+  for (std::string part; std::getline(ss, part, '.');) {
+    const YAML::Node& c = n;  // const access: operator[] must not insert the key
+    if (!c || !c.IsMap() || !c[part]) return std::nullopt;
+    n.reset(c[part]);
+  }
+  return n;
+}
+
+}  // namespace
+
+const std::vector<EffectiveValue>& effective_config() { return registry(); }
+
+std::string effective_config_yaml(const std::vector<EffectiveValue>& values) {
+  std::ostringstream o;
+  o << "# Effective configuration (key: value  # origin: default, the YAML file, or --set/a flag)\n";
+  std::size_t width = 0;
+  for (const auto& v : values) width = std::max(width, v.key.size() + v.value.size() + 2);
+  for (const auto& v : values) {
+    const std::string line = v.key + ": " + v.value;
+    o << line << std::string(width + 2 - line.size(), ' ') << "# " << v.origin << "\n";
+  }
+  return o.str();
+}
+
+namespace detail {
+
+ConfigMap with_overrides(ConfigMap map, const std::string& file, const std::vector<std::string>& overrides) {
+  if (overrides.empty()) {
+    map.set_overridden({}, file);
+    return map;
+  }
+  YAML::Node root = YAML::Clone(map.node());
+  if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  std::set<std::string> keys;
+  for (const auto& o : overrides) {
+    const std::string key = override_key(o);
+    if (!file.empty()) {
+      if (auto before = at_path(map.node(), key)) {
+        YAML::Emitter e;
+        e << YAML::Flow << *before;
+        const std::string now = o.substr(std::min(o.size(), key.size() + 1));
+        if (e.c_str() != now) {
+          std::cerr << program_invocation_short_name << ": note: --set " << o << " replaces " << key << ": "
+                    << e.c_str() << " from " << file << ":" << before->Mark().line + 1 << std::endl;
+        }
+      }
+    }
+    apply_override(root, o);
+    keys.insert(key);
+  }
+  ConfigMap merged(root, file.empty() ? std::string("--set") : file + " + --set");
+  merged.set_overridden(std::move(keys), file);
+  return merged;
+}
+
+void record_effective(const std::vector<EffectiveValue>& values) {
+  auto& all = registry();
+  all.insert(all.end(), values.begin(), values.end());
+  const char* out = std::getenv(kEffectiveConfigEnv);
+  if (!out || !*out) return;
+  std::ofstream f(out);
+  f << "# " << program_invocation_short_name << "\n" << effective_config_yaml(all);
+  if (!f) std::cerr << program_invocation_short_name << ": cannot write the effective configuration to " << out << std::endl;
+}
+
+}  // namespace detail
 
 void apply_override(YAML::Node& root, const std::string& assignment) {
   const auto eq = assignment.find('=');

@@ -138,6 +138,24 @@ TEST(RunFolder, CoverageCsvMarksTheRowsFromTime95AndTheEndGame) {
   EXPECT_EQ(none.find(",1,"), std::string::npos) << none;
 }
 
+TEST(RunFolder, CoveragePictureEndsAtTheRunsEndAndShowsTheObjects) {
+  RunSummary s = example(true);
+  s.time_limit_s = 600.0;
+  s.time_f_s = 52.5;
+  s.coverage.clear();
+  for (int i = 0; i <= 5; ++i) s.coverage.push_back({i * 10.0, i * 18.0, i * 2.5, i * 1000, i * 15.0});
+  const CoverageFigure f = coverage_figure(s);
+  EXPECT_EQ(f.options.t_max_s, 52.5) << "the run's end, not the 600 s limit";
+  ASSERT_EQ(f.series.size(), 2u);
+  EXPECT_EQ(f.series[0].points.back(), std::make_pair(50.0, 90.0));
+  EXPECT_EQ(f.series[1].points.back(), std::make_pair(50.0, 75.0));
+  EXPECT_NE(f.series[1].label.find("objects"), std::string::npos);
+  EXPECT_FALSE(f.series[0].label.empty()) << "two curves need a legend";
+  // A run cut before its last sample still shows every sample.
+  s.time_f_s = 20.0;
+  EXPECT_EQ(coverage_figure(s).options.t_max_s, 50.0);
+}
+
 TEST(RunFolder, AFolderThatCannotBeCreatedIsAnErrorNamingIt) {
   const std::string base = test::temp_dir("blocked");
   fs::create_directories(base);

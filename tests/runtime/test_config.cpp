@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
+#include <sstream>
 
 #include "semx/runtime/config.hpp"
 
@@ -121,4 +123,47 @@ TEST(Config, OverridesApplyOnTopOfTheFile) {
   EXPECT_THROW(load_config<Demo>(path, {"nonsense"}), ConfigError);
   EXPECT_THROW(load_config<Demo>(path, {"inner.k=99"}), ConfigError);
   EXPECT_THROW(load_config<Demo>(path, {"typo=1"}), ConfigError);
+}
+
+TEST(Config, TheEffectiveConfigurationSaysWhereEveryValueCameFrom) {
+  const std::string path = testing::TempDir() + "/semx_config_effective.yaml";
+  std::ofstream(path) << "rate: 10\ninner:\n  k: 1\n";
+  const std::string out = testing::TempDir() + "/semx_config_effective.out.yaml";
+  setenv(kEffectiveConfigEnv, out.c_str(), 1);
+  const std::size_t before = effective_config().size();
+  testing::internal::CaptureStderr();
+  const Demo d = load_config<Demo>(path, {"inner.k=9", "count=4", "rate=10"});
+  const std::string note = testing::internal::GetCapturedStderr();
+  unsetenv(kEffectiveConfigEnv);
+  EXPECT_EQ(d.inner.k, 9);
+
+  std::map<std::string, EffectiveValue> by_key;
+  for (std::size_t i = before; i < effective_config().size(); ++i) by_key[effective_config()[i].key] = effective_config()[i];
+  ASSERT_TRUE(by_key.count("rate") && by_key.count("count") && by_key.count("inner.k") && by_key.count("mode") &&
+              by_key.count("inner.v"));
+  EXPECT_EQ(by_key["rate"].value, "10");
+  EXPECT_EQ(by_key["rate"].origin, "--set") << "set twice: the flag is what counts";
+  EXPECT_EQ(by_key["inner.k"].value, "9");
+  EXPECT_EQ(by_key["inner.k"].origin, "--set");
+  EXPECT_EQ(by_key["count"].origin, "--set");
+  EXPECT_EQ(by_key["mode"].value, "a");
+  EXPECT_EQ(by_key["mode"].origin, "default");
+  EXPECT_EQ(by_key["inner.v"].value, "[1, 2]");
+  EXPECT_EQ(load_config<Demo>(path).rate, 10.0);
+  EXPECT_EQ(effective_config().back().key, "inner.v");
+  for (std::size_t i = 0; i < effective_config().size(); ++i) {
+    if (effective_config()[i].key == "rate" && i >= before + by_key.size()) {
+      EXPECT_EQ(effective_config()[i].origin, path) << "from the file when no flag sets it";
+    }
+  }
+  // A flag that replaces the file's value says so; one that repeats it does not.
+  EXPECT_TRUE(contains(note, "--set inner.k=9 replaces inner.k: 1 from " + path + ":3")) << note;
+  EXPECT_FALSE(contains(note, "rate")) << note;
+  // The file the launcher asks for.
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_TRUE(contains(ss.str(), "inner.k: 9")) << ss.str();
+  EXPECT_TRUE(contains(ss.str(), "# --set")) << ss.str();
+  EXPECT_TRUE(contains(ss.str(), "# default")) << ss.str();
 }

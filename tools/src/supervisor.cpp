@@ -18,6 +18,8 @@
 #include <memory>
 #include <vector>
 
+#include "semx/runtime/config.hpp"
+
 namespace semx::tools {
 
 namespace {
@@ -72,6 +74,7 @@ class Supervisor {
     int k = 0;
     const double t0 = now_s();
     const std::string log_dir = o.log_dir.empty() ? set.log_dir : o.log_dir;
+    log_dir_ = log_dir;
     if (!log_dir.empty()) {
       std::error_code ec;
       std::filesystem::create_directories(log_dir, ec);
@@ -232,6 +235,10 @@ class Supervisor {
       const int devnull = open("/dev/null", O_RDONLY);
       if (devnull >= 0) dup2(devnull, STDIN_FILENO);
       if (!o_.lcm_url.empty()) setenv("LCM_DEFAULT_URL", o_.lcm_url.c_str(), 1);
+      // Every process records the configuration it runs with next to its log (runtime/config.hpp).
+      if (!log_dir_.empty()) {
+        setenv(runtime::kEffectiveConfigEnv, (log_dir_ + "/" + c.spec->name + ".config.yaml").c_str(), 1);
+      }
       for (const auto& [k, v] : c.spec->env) setenv(k.c_str(), v.c_str(), 1);
       std::vector<char*> argv;
       for (auto& a : argv_s) argv.push_back(a.data());
@@ -347,6 +354,7 @@ class Supervisor {
   SupervisorOptions o_;
   std::vector<Child> children_;
   std::size_t width_ = 0;
+  std::string log_dir_;  // the set's log_dir (or --log-dir): where processes write their logs and configs
   bool stopping_ = false;
   bool killed_ = false;
   double kill_at_ = 0;

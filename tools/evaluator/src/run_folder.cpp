@@ -221,15 +221,26 @@ std::vector<std::string> write_run_metrics(const std::string& dir, const RunSumm
   text("metrics.csv", metrics_csv_header() + metrics_csv_row(s));
   text("coverage.csv", coverage_csv(s));
   text("time_split.json", s.time_split.to_json());
-  CoveragePlotOptions po;
+  const CoverageFigure figure = coverage_figure(s);
+  const std::string png = (d / "coverage.png").string();
+  write_coverage_plot(png, figure.series, figure.options);
+  written.push_back(png);
+  return written;
+}
+
+CoverageFigure coverage_figure(const RunSummary& s) {
+  CoverageFigure f;
+  CoveragePlotOptions& po = f.options;
   po.title = "coverage over time: " + (s.info.world.empty() ? std::string("run") : s.info.world) +
              (s.info.planner.empty() ? "" : ", " + s.info.planner);
   po.threshold_pct = s.coverage_threshold_pct;
-  if (s.time_limit_s) po.t_max_s = std::max(*s.time_limit_s, s.time_f_s);
-  const std::string png = (d / "coverage.png").string();
-  write_coverage_plot(png, {coverage_series(s.coverage)}, po);
-  written.push_back(png);
-  return written;
+  po.t_max_s = std::max(s.time_f_s, s.coverage.empty() ? 0.0 : s.coverage.back().t_s);
+  f.series.push_back(coverage_series(s.coverage, "map (target set)"));
+  PlotSeries objects;
+  objects.label = "objects (furniture surfaces)";
+  for (const auto& c : s.coverage) objects.points.emplace_back(c.t_s, c.object_coverage_pct);
+  f.series.push_back(std::move(objects));
+  return f;
 }
 
 std::string format_metrics_table(const RunSummary& s) {

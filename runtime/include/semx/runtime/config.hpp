@@ -30,6 +30,15 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The configuration a process runs with, as `rosparam dump` would show it: every key a module
+// read, its value, and where the value came from: "default", the YAML file, or "--set" (a flag,
+// including the shorthands such as the planner's --samples, which are --set underneath).
+struct EffectiveValue {
+  std::string key;     // dotted path
+  std::string value;   // YAML text
+  std::string origin;  // "default", the file's path, or "--set"
+};
+
 // A view of one YAML mapping. Keys are recorded as they are read so finish() can report the
 // ones nobody asked for.
 class ConfigMap {
@@ -61,6 +70,11 @@ class ConfigMap {
   // from it) was never read. Call it once, on the root, after the whole struct is loaded.
   void finish() const;
 
+  // Every value read so far anywhere in the document, with its origin (effective_config()).
+  const std::vector<EffectiveValue>& effective() const { return log_->values; }
+  // Keys (dotted) whose values came from --set rather than from source(): load_config's.
+  void set_overridden(std::set<std::string> keys, std::string file);
+
   // "file:line:col" of `key`, or of this map when key is empty.
   std::string where(const std::string& key = "") const;
   const std::string& source() const { return source_; }
@@ -75,7 +89,11 @@ class ConfigMap {
 
   struct ReadLog {
     std::map<std::string, std::set<std::string>> keys;  // map path -> keys read there
+    std::vector<EffectiveValue> values;                 // in the order read
+    std::set<std::string> overridden;                   // dotted keys set by --set
+    std::string file;                                   // the YAML file, "" for none
   };
+  void note(const std::string& key, const std::string& value, bool present);
   ConfigMap(YAML::Node node, std::string source, std::string path, std::shared_ptr<ReadLog> log);
   void check_unread(const YAML::Node& node, const std::string& path) const;
 
@@ -88,6 +106,15 @@ class ConfigMap {
 // Applies "a.b.c=value" overrides (from --set flags) onto a YAML document before it is read.
 void apply_override(YAML::Node& root, const std::string& assignment);
 
+// Every value load_config() read in this process so far (each call appends its struct's).
+const std::vector<EffectiveValue>& effective_config();
+// The effective configuration as YAML with the origin of each value as a comment.
+std::string effective_config_yaml(const std::vector<EffectiveValue>& values);
+// Where load_config() writes effective_config_yaml() after each call: $SEMX_CONFIG_OUT (the
+// launcher sets it to LOG_DIR/NAME.config.yaml, so a run folder holds every process's), or
+// nowhere when unset.
+inline constexpr const char* kEffectiveConfigEnv = "SEMX_CONFIG_OUT";
+
 // Loads a config struct from a file (or defaults when `file` is empty) plus overrides.
 // `load` must be findable by ADL: void load(ConfigMap&, T&).
 template <class T>
@@ -96,6 +123,15 @@ T load_config(const std::string& file, const std::vector<std::string>& overrides
 // ---- implementation of the templates ----
 
 namespace detail {
+// A value as one line of YAML (flow style, doubles to 15 digits: 0.1, not 0.10000000000000001).
+template <class T>
+std::string yaml_text(const T& value) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(15);
+  e.SetFloatPrecision(7);
+  e << YAML::Flow << value;
+  return e.c_str();
+}
 template <class T>
 const char* type_name();
 template <class T>
@@ -105,12 +141,16 @@ bool convert(const YAML::Node& node, T& out);
 template <class T>
 void ConfigMap::get(const std::string& key, T& out) {
   const std::optional<YAML::Node> v = value(key);
-  if (!v) return;
+  if (!v) {
+    note(key, detail::yaml_text(out), false);
+    return;
+  }
   T parsed{};
   if (!detail::convert(*v, parsed)) {
     fail(key, std::string("expected ") + detail::type_name<T>());
   }
   out = parsed;
+  note(key, detail::yaml_text(*v), true);
 }
 
 template <class T>
@@ -124,18 +164,21 @@ void ConfigMap::get(const std::string& key, T& out, T lo, T hi) {
   out = parsed;
 }
 
+namespace detail {
+// Applies the overrides to `map`'s document (saying on stderr when one replaces a value the file
+// set: a flag silently beating the YAML was a trap) and records which keys they set.
+ConfigMap with_overrides(ConfigMap map, const std::string& file, const std::vector<std::string>& overrides);
+void record_effective(const std::vector<EffectiveValue>& values);
+}  // namespace detail
+
 template <class T>
 T load_config(const std::string& file, const std::vector<std::string>& overrides) {
-  ConfigMap map = file.empty() ? ConfigMap::empty() : ConfigMap::from_file(file);
-  if (!overrides.empty()) {
-    YAML::Node root = map.node();
-    if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
-    for (const auto& o : overrides) apply_override(root, o);
-    map = ConfigMap(root, file.empty() ? std::string("--set") : file + " + --set");
-  }
+  ConfigMap map = detail::with_overrides(file.empty() ? ConfigMap::empty() : ConfigMap::from_file(file), file,
+                                         overrides);
   T cfg{};
   load(map, cfg);
   map.finish();
+  detail::record_effective(map.effective());
   return cfg;
 }
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/evaluator/coverage_plot.hpp"
 #include "semx/evaluator/run_summary.hpp"
 
 namespace semx::evaluator {
@@ -39,6 +40,15 @@ std::vector<CoverageSample> read_coverage_csv(const std::string& path);
 // Creates `dir` if needed and writes metrics.json, metrics.csv, coverage.csv and coverage.png.
 // Returns the paths written. (map.png needs the map: see write_map_png in map_picture.hpp.)
 std::vector<std::string> write_run_metrics(const std::string& dir, const RunSummary& s);
+
+// What coverage.png shows: the target set's coverage and the objects' (the furniture surfaces
+// the semantic layer is for) over the run, the time axis ending at the run's end (Time_f, or the
+// last sample), not at the time limit, which squashed a short run into its first pixels.
+struct CoverageFigure {
+  std::vector<PlotSeries> series;
+  CoveragePlotOptions options;
+};
+CoverageFigure coverage_figure(const RunSummary& s);
 
 // The final metrics table people read at the end of a run.
 std::string format_metrics_table(const RunSummary& s);
