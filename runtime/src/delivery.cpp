@@ -32,14 +32,14 @@ Inbox::Arrival Inbox::arrive(const StreamKey& s, uint32_t seq, const std::string
   }
   if (st.last_request >= 0) ++counters_.recovered;
   ++st.next;
-  release(st);
+  release(s, st);
   return Arrival::kDeliver;
 }
 
-void Inbox::release(Stream& st) {
+void Inbox::release(const StreamKey& key, Stream& st) {
   for (auto it = st.held.begin(); it != st.held.end() && it->first == st.next; it = st.held.erase(it)) {
     held_bytes_ -= it->second.bytes.size();
-    ready_.push_back({std::move(it->second.channel), std::move(it->second.bytes)});
+    ready_.push_back({std::move(it->second.channel), std::move(it->second.bytes), key, it->first});
     ++st.next;
   }
   if (!missing(st)) {
@@ -113,7 +113,7 @@ std::vector<ResendRequest> Inbox::give_up(double now) {
     if (!too_long && held_bytes_ <= o_.max_held_bytes) continue;
     while (st.next <= st.want) {
       if (st.held.count(st.next)) {
-        release(st);
+        release(key, st);
         continue;
       }
       if (lost.empty() || lost.back().stream.sender != key.sender || lost.back().stream.tag != key.tag ||
@@ -125,7 +125,7 @@ std::vector<ResendRequest> Inbox::give_up(double now) {
       ++counters_.lost;
       ++st.next;
     }
-    release(st);
+    release(key, st);
   }
   return lost;
 }

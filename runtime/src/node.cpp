@@ -284,14 +284,34 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
         break;
     }
   }
-  dispatch(channel, data, size, size - kAuthTrailerBytes);
+  if (!tracked(channel)) {
+    dispatch(channel, data, size, size - kAuthTrailerBytes);
+    return;
+  }
+  deliver_in_turn(channel, data, size, {trailer.sender, channel_tag(channel)}, trailer.seq);
   // Held messages a gap kept back, now in their publisher's order.
   deliver_ready();
 }
 
+bool Node::before_held_tick(const StreamKey& stream, uint32_t seq) const {
+  if (held_ticks_.empty()) return true;
+  const auto& heads = held_ticks_.front().heads;
+  const auto it = heads.find(stream);
+  return it != heads.end() && seq <= it->second;
+}
+
+void Node::deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
+                           uint32_t seq) {
+  if (stream.sender == signer_.sender() || before_held_tick(stream, seq)) {
+    dispatch(channel, data, size, size - kAuthTrailerBytes);
+    return;
+  }
+  deferred_.push_back({channel, std::vector<uint8_t>(data, data + size), stream, seq});
+}
+
 void Node::deliver_ready() {
   Inbox::Ready r;
-  while (inbox_.ready(&r)) dispatch(r.channel, r.bytes.data(), r.bytes.size(), r.bytes.size() - kAuthTrailerBytes);
+  while (inbox_.ready(&r)) deliver_in_turn(r.channel, r.bytes.data(), r.bytes.size(), r.stream, r.seq);
 }
 
 void Node::dispatch(const std::string& channel, const uint8_t* data, std::size_t size, std::size_t payload) {
@@ -394,9 +414,19 @@ void Node::service_delivery() {
   if (!lost.empty()) deliver_ready();
   counters_.recovered = inbox_.counters().recovered;
   while (!held_ticks_.empty() && inbox_.complete()) {
-    const semx::clock_t tick = std::move(held_ticks_.front());
+    const semx::clock_t tick = std::move(held_ticks_.front().msg);
     held_ticks_.pop_front();
     handle_tick(tick);
+    // What came after that tick, up to the next held one (or all of it), in the order it came.
+    std::deque<Inbox::Ready> later;
+    later.swap(deferred_);
+    for (auto& d : later) {
+      if (before_held_tick(d.stream, d.seq)) {
+        dispatch(d.channel, d.bytes.data(), d.bytes.size(), d.bytes.size() - kAuthTrailerBytes);
+      } else {
+        deferred_.push_back(std::move(d));
+      }
+    }
   }
 }
 
@@ -529,7 +559,7 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
 void Node::on_clock_message(const semx::clock_t& msg) {
   // A tick already waiting (the clock sends it again until acked) changes nothing.
   for (const auto& h : held_ticks_) {
-    if (h.tick == msg.tick) return;
+    if (h.msg.tick == msg.tick) return;
   }
   std::vector<StreamHead> heads;
   heads.reserve(static_cast<std::size_t>(msg.num_heads));
@@ -539,7 +569,9 @@ void Node::on_clock_message(const semx::clock_t& msg) {
   }
   const bool complete = inbox_.tick(heads, wall_s());
   if (!complete || !held_ticks_.empty()) {
-    held_ticks_.push_back(msg);
+    HeldTick held{msg, {}};
+    for (const StreamHead& h : heads) held.heads[h.stream] = std::max(held.heads[h.stream], h.seq);
+    held_ticks_.push_back(std::move(held));
     service_delivery();
     return;
   }

@@ -262,7 +262,9 @@ TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
   const std::string keep = saved ? saved : "";
   unsetenv("LCM_DEFAULT_URL");
   const std::string out = temp_path("url.out");
-  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  // share: other tests' sets may hold the default port right now, and a set moves off a held
+  // port by default (BusClaim tests); here the URL itself is under test.
+  Process launcher({bin("semx-launch"), set, "--no-color", "--port-policy", "share"}, out);
   EXPECT_EQ(launcher.wait(20), 0);
   EXPECT_NE(read_file(out).find(std::string("url=") + semx::runtime::kDefaultLcmUrl + "."), std::string::npos)
       << read_file(out);
@@ -270,7 +272,7 @@ TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
   // children would take the kernel's 208 KiB default and lose camera frames).
   setenv("LCM_DEFAULT_URL", "udpm://239.255.76.67:7999?ttl=0", 1);
   const std::string out2 = temp_path("url2.out");
-  Process launcher2({bin("semx-launch"), set, "--no-color"}, out2);
+  Process launcher2({bin("semx-launch"), set, "--no-color", "--port-policy", "share"}, out2);
   EXPECT_EQ(launcher2.wait(20), 0);
   EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0&recv_buf_size=4194304."), std::string::npos)
       << read_file(out2);

@@ -56,11 +56,15 @@ roscore -p "$ros_port" >"$out/logs/roscore.log" 2>&1 &
 pids+=($!)
 wait_for 30 master_up || { say "roscore did not come up"; exit 1; }
 
-# 1. The simulated run, mirrored to ROS and recorded.
+# 1. The simulated run, mirrored to ROS and recorded. The bridge is not a child of the demo set,
+# so it gets the set's key from a file made here (a set accepts only messages signed with its key),
+# and the set shares the port the bridge already listens on (by default it would move away).
+key_file=$out/session.key
+(umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' >"$key_file"; echo >>"$key_file")
 cat >"$out/original_mapper.yaml" <<YAML
 checkpoint: {path: $out/original.ckpt, period: 86400}
 YAML
-"$BIN/semx-ros-bridge" --lcm-url "$url_a" >"$out/logs/bridge_mirror.log" 2>&1 &
+SEMX_AUTH_KEY_FILE=$key_file "$BIN/semx-ros-bridge" --lcm-url "$url_a" >"$out/logs/bridge_mirror.log" 2>&1 &
 bridge=$!
 pids+=($bridge)
 topics=(/semx/odom /tf /tf_static /clock /semx/camera/depth/image_raw /semx/camera/depth/camera_info
@@ -72,7 +76,7 @@ pids+=($recorder)
 wait_for 30 subscribed /semx/camera/depth/image_raw || { say "rosbag record did not subscribe"; exit 1; }
 sleep 1  # the bridge sees the subscriber within 0.2 s and converts images from then on
 say "recording a $time_limit s $world run (real time) to $out/sensors.bag"
-"$BIN/semx-launch" demo --lcm-url "$url_a" --no-color --arg "world=$world" --arg clock=realtime \
+"$BIN/semx-launch" demo --lcm-url "$url_a" --auth-key "$key_file" --port-policy share --no-color --arg "world=$world" --arg clock=realtime \
   --arg "time_limit=$time_limit" --arg "out=$out/original" --arg "mapper_config=$out/original_mapper.yaml" \
   >"$out/logs/demo.log" 2>&1 || { say "the simulated run failed (logs in $out/original/logs)"; tail -20 "$out/logs/demo.log"; exit 1; }
 sleep 2

@@ -83,6 +83,8 @@ class Inbox {
   struct Ready {
     std::string channel;
     std::vector<uint8_t> bytes;
+    StreamKey stream;
+    uint32_t seq = 0;
   };
   // Held messages whose turn came, in order.
   bool ready(Ready* out);
@@ -106,7 +108,7 @@ class Inbox {
     uint32_t asked = 0;        // everything up to here was asked for at least once
   };
   bool missing(const Stream& st) const { return st.next != 0 && st.next <= st.want; }
-  void release(Stream& st);
+  void release(const StreamKey& key, Stream& st);
   void start(Stream& st, uint32_t seq_seen, bool known_from_tick);
 
   uint64_t self_;

@@ -265,7 +265,20 @@ class Node {
   Inbox inbox_;
   ResendHistory history_;
   std::vector<uint8_t> resend_buffer_;
-  std::deque<semx::clock_t> held_ticks_;  // ticks waiting for messages their heads name
+  // Ticks waiting for messages their heads name, with those heads. While one waits, messages sent
+  // after it (beyond its heads) wait too: on a lossless bus they would come after the tick, and a
+  // node handles a tick with what it held before (a controller stepped with an ESDF the mapper
+  // sent during that tick, and flew another run).
+  struct HeldTick {
+    semx::clock_t msg;
+    std::map<StreamKey, uint32_t> heads;
+  };
+  std::deque<HeldTick> held_ticks_;
+  std::deque<Inbox::Ready> deferred_;
+  // Hands a message over now, or keeps it until the held tick before it is handled.
+  void deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
+                       uint32_t seq);
+  bool before_held_tick(const StreamKey& stream, uint32_t seq) const;
   struct AckHeads {
     int64_t sender = 0;
     std::vector<std::pair<int32_t, int32_t>> heads;  // (tag, seq)
