@@ -326,6 +326,7 @@ semx::node_status_t Node::status() const {
   s.wall_utime = wall_utime();
   s.node = options_.name;
   s.pid = static_cast<int32_t>(getpid());
+  s.restarts = options_.restarts;
   s.state = static_cast<int8_t>(state_);
   s.detail = detail_;
   s.received = counters_.received;

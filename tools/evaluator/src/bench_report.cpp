@@ -200,6 +200,13 @@ BenchRun load_bench_run(const std::string& dir) {
   if (m["end_game_s"] && !m["end_game_s"].IsNull()) r.end_game_s = number_of(m, "end_game_s", file);
   if (m["object_coverage_pct"] && !m["object_coverage_pct"].IsNull())
     r.object_coverage_pct = number_of(m, "object_coverage_pct", file);
+  r.disturbed = m["disturbed"] && m["disturbed"].IsScalar() && m["disturbed"].as<std::string>() == "true";
+  if (m["restarts"] && m["restarts"].IsSequence()) {
+    for (const auto& x : m["restarts"]) {
+      if (!x.IsMap() || !x["node"] || !x["t_s"]) continue;
+      r.restarts += (r.restarts.empty() ? "" : ", ") + x["node"].as<std::string>() + " " + x["t_s"].as<std::string>() + " s";
+    }
+  }
 
   const std::string csv = (fs::path(dir) / "coverage.csv").string();
   std::ifstream in(csv);
@@ -254,7 +261,9 @@ void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptio
   }
 }
 
-std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
+std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOptions& o) {
+  std::vector<BenchRun> runs, disturbed;
+  for (const auto& r : all) (r.disturbed ? disturbed : runs).push_back(r);
   std::ostringstream md;
   const auto worlds = worlds_of(runs);
   std::set<int> densities;
@@ -382,13 +391,24 @@ std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportO
   md << "\n"
      << runs.size() << " runs, " << fmt(sim, 0) << " simulated s in " << fmt(wall, 0)
      << " wall s of exploration (" << fmt(wall > 0 ? sim / wall : 0, 1) << "x real time).\n";
+  if (!disturbed.empty()) {
+    md << "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
+       << "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
+          "termination | folder |\n"
+       << "|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : disturbed) {
+      md << "| " << r.world << " | " << r.planner << " | " << r.samples << " | " << r.seed << " | "
+         << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | "
+         << fmt(r.coverage_pct, 2) << " | " << r.termination << " | " << r.dir << " |\n";
+    }
+  }
   return md.str();
 }
 
 std::string bench_csv(const std::vector<BenchRun>& runs) {
   std::ostringstream c;
   c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-       "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s\n";
+       "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s,disturbed\n";
   for (const auto& r : runs) {
     c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
       << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
@@ -398,13 +418,17 @@ std::string bench_csv(const std::vector<BenchRun>& runs) {
       << (r.time_o_s ? fmt(*r.time_o_s, 3) : std::string()) << ','
       << (r.time_95_s ? fmt(*r.time_95_s, 3) : std::string()) << ','
       << (r.time_settled_s ? fmt(*r.time_settled_s, 3) : std::string()) << ','
-      << (r.end_game_s ? fmt(*r.end_game_s, 3) : std::string()) << '\n';
+      << (r.end_game_s ? fmt(*r.end_game_s, 3) : std::string()) << ',' << (r.disturbed ? "true" : "false")
+      << '\n';
   }
   return c.str();
 }
 
-std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
+std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, const std::string& dir,
                                            const BenchReportOptions& o) {
+  std::vector<BenchRun> runs;
+  for (const auto& r : all)
+    if (!r.disturbed) runs.push_back(r);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
     std::vector<const BenchRun*> here;

@@ -27,6 +27,7 @@
 
 #include "semx/runtime/channel_pattern.hpp"
 #include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/restart_count.hpp"
 #include "semx/runtime/sim_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
 #include "semx/runtime/udpm_sender.hpp"
@@ -51,6 +52,8 @@ struct NodeOptions {
   // status_period_s: a process started at the same time (the lockstep simulator, which waits to
   // hear every node it must wait for) hears this one within a fraction of a second, not a period.
   bool announce = false;
+  // How often the launcher restarted this process (restart_count.hpp), reported in NODE_STATUS.
+  int restarts = restart_count();
 };
 
 struct ChannelCounters {

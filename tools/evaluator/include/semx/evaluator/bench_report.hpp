@@ -26,6 +26,10 @@ struct BenchRun {
   std::optional<double> object_coverage_pct;
   int64_t collisions = 0;
   std::vector<std::pair<double, double>> coverage;  // (t s, %)
+  // A process of the set was restarted during the run (metrics.json "disturbed"): listed under
+  // the tables, never in them; `restarts` says which and when ("mapper 12.3 s, ...").
+  bool disturbed = false;
+  std::string restarts;
 };
 
 // Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
@@ -45,14 +49,14 @@ struct BenchReportOptions {
   double threshold_pct = 85.0;
 };
 
-// Markdown: the sweep table, the comparison table (with Time_95, the end game and Time_o, the
+// Markdown (disturbed runs are left out of every table and listed after them): the sweep table, the comparison table (with Time_95, the end game and Time_o, the
 // objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
 // the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
 // baseline (Time_f, Time_r, Time_o, Distance, in %), each world in the order the runs name them.
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
 // One row per run (the columns of metrics.csv plus the folder).
 std::string bench_csv(const std::vector<BenchRun>& runs);
-// DIR/coverage_WORLD.png per world: the mean coverage curve over seeds of every planner at the
+// DIR/coverage_WORLD.png per world (undisturbed runs): the mean coverage curve over seeds of every planner at the
 // comparison density. Returns the files written.
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
                                            const BenchReportOptions& options = {});
