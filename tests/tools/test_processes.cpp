@@ -424,6 +424,7 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   const std::string url = semx::runtime::udpm_url_for_port(test_port(5));
   const std::string semx_cmd = std::string(SEMX_SOURCE_DIR) + "/semx";
   const std::string log = temp_path("recorded.lcmlog");
+  std::filesystem::remove(log);
   semx::runtime::NodeOptions o;
   o.name = "talker";
   o.lcm_url = url;
@@ -435,8 +436,11 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   Process recorder(
       {"/bin/bash", semx_cmd, "record", "--out", log, "--lcm-url", url, "--channels", "SIM_CLOCK"},
       temp_path("record.out"));
-  std::this_thread::sleep_for(
-      std::chrono::milliseconds(2500));  // dependency check and build, then the logger subscribes
+  // The dependency check and the build come first (seconds on a loaded machine), then the logger
+  // creates its file and subscribes: a signal sent before that would reach bash, not the logger.
+  for (int i = 0; i < 600 && !std::filesystem::exists(log); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
   for (int i = 0; i < 50; ++i) {
     semx::clock_t c{};
     c.tick = i;
