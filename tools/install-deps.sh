@@ -11,6 +11,8 @@ packages=(
   # maths, maps, perception, config
   libeigen3-dev liboctomap-dev libpcl-dev libopencv-dev libyaml-cpp-dev zlib1g-dev
   libnanoflann-dev liblbfgspp-dev libnlopt-cxx-dev
+  # the messages' authentication tags (libcrypto)
+  libssl-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # headless display for lcm-spy and viewer checks; process tools for the launcher tests

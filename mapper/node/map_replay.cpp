@@ -16,6 +16,7 @@
 #include "semx/mapper/map_export.hpp"
 #include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/log_session.hpp"
 #include "semx/runtime/wire_validator.hpp"
 
 namespace semx::mapper {
@@ -25,6 +26,14 @@ namespace fs = std::filesystem;
 ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
   ReplayReport r;
   r.layout = runtime::scan_log(options.log_path);
+  std::unique_ptr<runtime::LogSession> session;
+  try {
+    const auto key = options.auth_key_file.empty() ? runtime::key_beside(options.log_path)
+                                                   : runtime::AuthKey::from_file(options.auth_key_file);
+    session = std::make_unique<runtime::LogSession>(options.log_path, r.layout, key);
+  } catch (const std::exception& e) {
+    throw ReplayError(e.what());
+  }
   lcm::LogFile log(options.log_path, "r");
   if (!log.good()) throw ReplayError(options.log_path + ": lcm::LogFile cannot open it");
 
@@ -41,11 +50,13 @@ ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
   for (int64_t i = 0; i < r.layout.events; ++i) {
     const lcm::LogEvent* e = log.readNextEvent();
     if (!e) throw ReplayError(options.log_path + ": lcm::LogFile stopped at event " + std::to_string(i));
+    const auto* data = static_cast<const uint8_t*>(e->data);
+    const auto payload = session->payload(e->channel, data, static_cast<size_t>(e->datalen));
+    if (!payload) continue;
+    const size_t size = *payload;
     ++r.channels[e->channel];
     if (e->channel != options.channel) continue;
     ++r.depth_events;
-    const auto* data = static_cast<const uint8_t*>(e->data);
-    const size_t size = static_cast<size_t>(e->datalen);
     const runtime::WireError we =
         runtime::validate_wire(schema, *type, semx::depth_image_t::getHash(), data, size);
     if (we != runtime::WireError::kNone) {
@@ -88,6 +99,7 @@ ReplayReport replay_log(const ReplayOptions& options, Mapper& mapper) {
     if (r.first_utime < 0) r.first_utime = msg.utime;
     r.last_utime = std::max(r.last_utime, msg.utime);
   }
+  r.left_out = session->summary();
   return r;
 }
 

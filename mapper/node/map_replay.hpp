@@ -25,6 +25,7 @@ using ReplayError = runtime::LogError;
 struct ReplayOptions {
   std::string log_path;
   std::string channel = "CAMERA_DEPTH";
+  std::string auth_key_file;  // "" : session.key beside the log, if any (runtime/log_session.hpp)
 };
 
 struct ReplayReport {
@@ -35,6 +36,7 @@ struct ReplayReport {
   int64_t rejected = 0;   // decoded frames the integrator refused (reason in first_error)
   int64_t malformed = 0;  // events that are not a valid depth_image_t or not a plausible frame
   int64_t skipped = 0;    // not due (integration.frame_period_s), as the live mapper skips them
+  std::string left_out;   // another set's or refused events (LogSession::summary), "" if none
   std::string first_error;
   int64_t first_utime = -1;
   int64_t last_utime = -1;

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
           "recording?); read the %lld complete events before it\n",
           static_cast<unsigned long long>(r.layout.truncated_at), static_cast<long long>(r.layout.events));
     }
+    if (!r.left_out.empty()) std::printf("semx-map-replay: warning: %s\n", r.left_out.c_str());
     if (r.depth_events == 0) {
       std::string seen;
       for (const auto& [name, n] : r.channels)

@@ -15,7 +15,9 @@
 #include <iterator>
 
 #include "semx/runtime/channels.hpp"
+#include "semx/runtime/lcm_datagram.hpp"
 #include "semx/runtime/lcm_url.hpp"
+#include "semx/runtime/udpm_sender.hpp"
 
 namespace semx::runtime {
 
@@ -53,6 +55,33 @@ bool worth_logging(int64_t n) {
   return n == 1;
 }
 
+double wall_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Channels whose messages are numbered for resending: all but the clock's own protocol (a lost
+// tick or ack is sent again by the clock) and the heartbeat.
+bool tracked(const std::string& channel) {
+  return channel != channels::SIM_CLOCK && channel != channels::SIM_ACK && channel != channels::NODE_STATUS &&
+         channel != channels::SIM_RESEND;
+}
+
+Inbox::Options inbox_options(const NodeOptions& o) {
+  Inbox::Options io;
+  // In lockstep a gap costs only wall time, so it is waited for long; in realtime a message
+  // that comes much later is old news.
+  io.give_up_s = o.lockstep ? 3.0 : 0.3;
+  return io;
+}
+
+AuthKey node_key(const NodeOptions& o) {
+  try {
+    return AuthKey::resolve(o.auth_key_file);
+  } catch (const std::exception& e) {
+    throw NodeError(o.name + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 const char* to_string(NodeState s) {
@@ -86,9 +115,16 @@ void install_shutdown_handlers() {
 bool shutdown_requested() { return g_shutdown.load(); }
 void request_shutdown() { g_shutdown.store(true); }
 
-Node::Node(NodeOptions options) : options_(std::move(options)), clock_(options_.lockstep) {
+Node::Node(NodeOptions options)
+    : options_(std::move(options)),
+      key_(node_key(options_)),
+      signer_(key_),
+      verifier_(key_),
+      inbox_(signer_.sender(), inbox_options(options_)),
+      clock_(options_.lockstep) {
   if (options_.name.empty()) throw NodeError("a node needs a name");
   options_.lcm_url = resolve_lcm_url(options_.lcm_url);
+  from_log_ = options_.lcm_url.rfind("file://", 0) == 0;
   const char* transport = std::getenv("SEMX_LCM_TRANSPORT");
   if (!(transport && std::string(transport) == "liblcm")) udpm_ = parse_udpm_url(options_.lcm_url);
   if (udpm_) {
@@ -109,6 +145,9 @@ Node::Node(NodeOptions options) : options_(std::move(options)), clock_(options_.
                  (m.mode == semx::clock_t::REALTIME || m.mode == semx::clock_t::LOCKSTEP);
         });
   }
+  subscribe<semx::resend_t>(
+      channels::SIM_RESEND, [this](const semx::resend_t& r) { on_resend_request(r); },
+      [](const semx::resend_t& r) { return r.first_seq >= 1 && r.last_seq >= r.first_seq; });
   next_status_ = std::chrono::steady_clock::now();
 }
 
@@ -129,6 +168,7 @@ void Node::ensure_lcm_subscription(const std::string& channel) {
     }
   }
   subs_[channel];
+  inbox_.reads(channel_tag(channel));
   if (udpm_) {
     receive_channels_.push_back(channel);
     update_receiver();
@@ -139,7 +179,24 @@ void Node::ensure_lcm_subscription(const std::string& channel) {
 
 void Node::update_receiver() {
   try {
-    if (!receiver_) receiver_ = std::make_unique<UdpmReceiver>(*udpm_, options_.max_message_bytes);
+    if (!receiver_) {
+      receiver_ = std::make_unique<UdpmReceiver>(*udpm_, options_.max_message_bytes);
+      if (const char* rate = std::getenv("SEMX_TEST_DROP_RATE"); rate && *rate) {
+        // A lossy bus for tests and experiments: this node loses that share of its datagrams.
+        const char* seed = std::getenv("SEMX_TEST_DROP_SEED");
+        receiver_->drop_for_test(std::atof(rate),
+                                 std::hash<std::string>{}(options_.name) ^ (seed ? std::strtoull(seed, nullptr, 10) : 0));
+      }
+      if (receiver_->granted_recv_buf() < receiver_->requested_recv_buf()) {
+        throw NodeError("the LCM URL asks for a " + std::to_string(receiver_->requested_recv_buf()) +
+                        "-byte receive buffer and the kernel grants " +
+                        std::to_string(receiver_->granted_recv_buf()) +
+                        " (net.core.rmem_max): bursts of camera frames would be lost. Raise it (as root: sysctl "
+                        "-w net.core.rmem_max=" +
+                        std::to_string(receiver_->requested_recv_buf()) +
+                        "), or ask for less with recv_buf_size= in the URL");
+      }
+    }
     std::vector<std::string> refused;
     for (const auto& c : never_wanted_)
       if (!subs_.count(c)) refused.push_back(c);
@@ -153,9 +210,9 @@ void Node::skip_unless(const std::string& channel, std::function<bool(int64_t ut
   skip_filters_[channel] = std::move(wanted);
 }
 
-void Node::subscribe_raw(const std::string& regex, RawHandler handler) {
+void Node::subscribe_raw(const std::string& regex, RawHandler handler, bool with_trailer) {
   try {
-    raw_handlers_.push_back({ChannelPattern(regex), std::move(handler)});
+    raw_handlers_.push_back({ChannelPattern(regex), std::move(handler), with_trailer});
   } catch (const std::invalid_argument& e) {
     throw NodeError(e.what());
   }
@@ -172,15 +229,19 @@ void Node::never_wanted(std::vector<std::string> channels) {
 }
 
 void Node::on_lcm_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  on_raw_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+  // liblcm calls the typed subscription of a channel first; a channel without one reaches here
+  // only, and is checked here.
+  if (subs_.count(channel)) return;
+  on_signed_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
 }
 
-void Node::on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size) {
+void Node::on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size,
+                          std::size_t payload) {
   // Raw subscribers see the bytes as they came; they count nothing as malformed themselves.
   for (auto& raw : raw_handlers_) {
     if (!raw.pattern.matches(channel)) continue;
     try {
-      raw.handler(channel, data, size);
+      raw.handler(channel, data, raw.with_trailer ? size : payload);
     } catch (const std::exception& e) {
       note_handler_error(channel, e.what());
     }
@@ -188,7 +249,161 @@ void Node::on_raw_message(const std::string& channel, const uint8_t* data, std::
 }
 
 void Node::on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  on_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+  on_signed_message(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+}
+
+void Node::on_signed_message(const std::string& channel, const uint8_t* data, std::size_t size) {
+  if (from_log_) {
+    // A log the user chose to play (file://): nobody else writes into it, and logs from before
+    // messages were signed have no trailers. Only one set's messages are read, though: a stock
+    // lcm-logger may have recorded two sets at once.
+    const auto t = read_trailer(data, size);
+    if (t) {
+      if (!log_session_) log_session_ = t->session;
+      if (t->session != *log_session_) {
+        note_refused(channel, AuthVerdict::kForeign, *t);
+        return;
+      }
+    }
+    dispatch(channel, data, size, t ? size - kAuthTrailerBytes : size);
+    return;
+  }
+  AuthTrailer trailer;
+  const AuthVerdict verdict = verifier_.verify(channel, data, size, &trailer);
+  if (verdict != AuthVerdict::kOk) {
+    note_refused(channel, verdict, trailer);
+    return;
+  }
+  if (tracked(channel)) {
+    const StreamKey stream{trailer.sender, channel_tag(channel)};
+    switch (inbox_.arrive(stream, trailer.seq, channel, data, size, wall_s())) {
+      case Inbox::Arrival::kDuplicate:
+      case Inbox::Arrival::kHeld:
+        return;
+      case Inbox::Arrival::kDeliver:
+        break;
+    }
+  }
+  dispatch(channel, data, size, size - kAuthTrailerBytes);
+  // Held messages a gap kept back, now in their publisher's order.
+  deliver_ready();
+}
+
+void Node::deliver_ready() {
+  Inbox::Ready r;
+  while (inbox_.ready(&r)) dispatch(r.channel, r.bytes.data(), r.bytes.size(), r.bytes.size() - kAuthTrailerBytes);
+}
+
+void Node::dispatch(const std::string& channel, const uint8_t* data, std::size_t size, std::size_t payload) {
+  if (subs_.count(channel)) on_message(channel, data, payload);
+  if (!raw_handlers_.empty()) on_raw_message(channel, data, size, payload);
+}
+
+void Node::on_resend_request(const semx::resend_t& r) {
+  if (static_cast<uint64_t>(r.sender) != signer_.sender() || !sender_ && !lcm_) return;
+  // A bounded answer: a request cannot make a node send its whole history in one go.
+  const uint32_t first = static_cast<uint32_t>(r.first_seq);
+  const uint32_t last = std::min<uint32_t>(static_cast<uint32_t>(r.last_seq), first + 255);
+  for (uint32_t seq = first; seq <= last; ++seq) {
+    const std::string* channel = nullptr;
+    const std::vector<uint8_t>* kept = history_.find(static_cast<uint32_t>(r.channel_tag), seq, &channel);
+    if (!kept) continue;
+    resend_buffer_.assign(kept->begin(), kept->end() - static_cast<std::ptrdiff_t>(kAuthTrailerBytes));
+    signer_.sign_as(*channel, resend_buffer_, seq);
+    const bool sent = sender_ ? sender_->publish(*channel, resend_buffer_.data(), resend_buffer_.size())
+                              : lcm_->publish(*channel, resend_buffer_.data(),
+                                              static_cast<unsigned int>(resend_buffer_.size())) == 0;
+    if (sent) ++counters_.resent;
+  }
+}
+
+std::vector<std::pair<int32_t, int32_t>> Node::own_heads() const {
+  std::vector<std::pair<int32_t, int32_t>> out;
+  for (const auto& [channel, seq] : signer_.heads()) {
+    if (tracked(channel)) out.emplace_back(static_cast<int32_t>(channel_tag(channel)), static_cast<int32_t>(seq));
+  }
+  return out;
+}
+
+bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
+  if (!clock_source_ && channel == channels::SIM_CLOCK) {
+    clock_source_ = true;
+    subscribe<semx::ack_t>(channels::SIM_ACK, [this](const semx::ack_t& a) {
+      AckHeads& h = ack_heads_[a.node];
+      h.sender = a.sender;
+      h.heads.clear();
+      for (int i = 0; i < a.num_heads; ++i) h.heads.emplace_back(a.head_tag[i], a.head_seq[i]);
+    });
+  }
+  semx::clock_t m = msg;
+  if (channel == channels::SIM_CLOCK) {
+    m.head_sender.clear();
+    m.head_tag.clear();
+    m.head_seq.clear();
+    const auto add = [&m](int64_t sender, const std::vector<std::pair<int32_t, int32_t>>& heads) {
+      for (const auto& [tag, seq] : heads) {
+        m.head_sender.push_back(sender);
+        m.head_tag.push_back(tag);
+        m.head_seq.push_back(seq);
+      }
+    };
+    add(static_cast<int64_t>(signer_.sender()), own_heads());
+    for (const auto& [node, h] : ack_heads_) add(h.sender, h.heads);
+    m.num_heads = static_cast<int16_t>(std::min<std::size_t>(m.head_seq.size(), 32767));
+    m.head_sender.resize(static_cast<std::size_t>(m.num_heads));
+    m.head_tag.resize(static_cast<std::size_t>(m.num_heads));
+    m.head_seq.resize(static_cast<std::size_t>(m.num_heads));
+  }
+  in_publish_clock_ = true;
+  const bool ok = publish(channel, m);
+  in_publish_clock_ = false;
+  return ok;
+}
+
+void Node::service_delivery() {
+  const double now = wall_s();
+  for (const ResendRequest& q : inbox_.requests(now)) {
+    semx::resend_t r;
+    r.utime = clock_.now_utime();
+    r.node = options_.name;
+    r.sender = static_cast<int64_t>(q.stream.sender);
+    r.channel_tag = static_cast<int32_t>(q.stream.tag);
+    r.first_seq = static_cast<int32_t>(q.first);
+    r.last_seq = static_cast<int32_t>(q.last);
+    publish(channels::SIM_RESEND, r);
+  }
+  if (const int64_t lost = inbox_.give_up(now); lost > 0) {
+    counters_.lost += lost;
+    std::cerr << options_.name << ": gave up on " << lost << " lost message" << (lost == 1 ? "" : "s") << " ("
+              << counters_.lost << " so far): this run is not the one a lossless bus gives\n";
+    deliver_ready();
+  }
+  counters_.recovered = inbox_.counters().recovered;
+  while (!held_ticks_.empty() && inbox_.complete()) {
+    const semx::clock_t tick = std::move(held_ticks_.front());
+    held_ticks_.pop_front();
+    handle_tick(tick);
+  }
+}
+
+void Node::note_refused(const std::string& channel, AuthVerdict verdict, const AuthTrailer& trailer) {
+  auto& c = incoming_[channel];
+  if (verdict == AuthVerdict::kForeign) {
+    ++c.foreign;
+    ++counters_.foreign;
+    if (!options_.quiet && worth_logging(counters_.foreign)) {
+      std::cerr << options_.name << ": ignored a message of another set (session " << std::hex
+                << trailer.session << std::dec << ") on " << channel << " (" << counters_.foreign
+                << " so far): two sets share this bus\n";
+    }
+    return;
+  }
+  ++c.refused;
+  ++counters_.refused;
+  if (!options_.quiet && worth_logging(counters_.refused)) {
+    std::cerr << options_.name << ": refused a " << to_string(verdict) << " message on " << channel << " ("
+              << counters_.refused << " so far)\n";
+  }
 }
 
 void Node::on_message(const std::string& channel, const uint8_t* data, std::size_t size) {
@@ -254,8 +469,21 @@ void Node::note_handler_error(const std::string& channel, const char* what) {
 }
 
 bool Node::publish_raw(const std::string& channel, const void* data, std::size_t size) {
-  if (quiet_until_ > 0 && !may_publish() && channel != channels::NODE_STATUS &&
-      channel != channels::SIM_ACK) {
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  publish_buffer_.reserve(size + kAuthTrailerBytes);
+  publish_buffer_.assign(bytes, bytes + size);
+  return send_signed(channel, publish_buffer_);
+}
+
+bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) {
+  AuthTrailer trailer;
+  if (options_.sign) {
+    if (channel.empty() || channel.size() > kLcmMaxChannel) return false;
+    trailer = signer_.sign(channel, bytes);
+  }
+  const uint8_t* data = bytes.data();
+  const std::size_t size = bytes.size();
+  if (quiet_until_ > 0 && !may_publish() && tracked(channel)) {
     ++early_publishes_;
     if (worth_logging(early_publishes_)) {
       std::cerr << options_.name << ": published " << channel << " at utime " << clock_.now_utime()
@@ -265,7 +493,7 @@ bool Node::publish_raw(const std::string& channel, const void* data, std::size_t
   }
   auto& c = outgoing_[channel];
   c.outgoing = true;
-  const bool sent = sender_ ? sender_->publish(channel, static_cast<const uint8_t*>(data), size)
+  const bool sent = sender_ ? sender_->publish(channel, data, size)
                             : lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
   if (!sent) {
     ++c.dropped;
@@ -273,12 +501,35 @@ bool Node::publish_raw(const std::string& channel, const void* data, std::size_t
     return false;
   }
   ++c.messages;
-  c.bytes += static_cast<int64_t>(size);
+  // The message's own bytes, as readers count them (the trailer is transport).
+  c.bytes += static_cast<int64_t>(options_.sign ? size - kAuthTrailerBytes : size);
   ++counters_.sent;
+  // Kept for a reader that lost it; the buffer handed back is reused by the next message.
+  if (options_.sign && tracked(channel)) bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
   return true;
 }
 
 void Node::on_clock_message(const semx::clock_t& msg) {
+  // A tick already waiting (the clock sends it again until acked) changes nothing.
+  for (const auto& h : held_ticks_) {
+    if (h.tick == msg.tick) return;
+  }
+  std::vector<StreamHead> heads;
+  heads.reserve(static_cast<std::size_t>(msg.num_heads));
+  for (int i = 0; i < msg.num_heads; ++i) {
+    heads.push_back({{static_cast<uint64_t>(msg.head_sender[i]), static_cast<uint32_t>(msg.head_tag[i])},
+                     static_cast<uint32_t>(msg.head_seq[i])});
+  }
+  const bool complete = inbox_.tick(heads, wall_s());
+  if (!complete || !held_ticks_.empty()) {
+    held_ticks_.push_back(msg);
+    service_delivery();
+    return;
+  }
+  handle_tick(msg);
+}
+
+void Node::handle_tick(const semx::clock_t& msg) {
   const auto decision = clock_.on_clock(msg.tick, msg.utime, static_cast<ClockMode>(msg.mode));
   if (decision.new_tick) {
     if (msg.tick > 0 && msg.utime > 0) tick_period_us_ = msg.utime / msg.tick;
@@ -290,11 +541,17 @@ void Node::on_clock_message(const semx::clock_t& msg) {
                         last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
                         msg.utime - last_ack_utime_ < kAckIntervalUs;
   if (decision.ack && !skip_ack) {
-    semx::ack_t ack;
+    semx::ack_t ack{};
     ack.utime = msg.utime;
     ack.node = options_.name;
     ack.tick = msg.tick;
     ack.quiet_until = quiet_until_fn_ ? quiet_until_fn_(msg.utime) : 0;
+    ack.sender = static_cast<int64_t>(signer_.sender());
+    for (const auto& [tag, seq] : own_heads()) {
+      ack.head_tag.push_back(tag);
+      ack.head_seq.push_back(seq);
+    }
+    ack.num_heads = static_cast<int16_t>(ack.head_seq.size());
     publish(channels::SIM_ACK, ack);
     quiet_until_ = ack.quiet_until;
     last_ack_utime_ = msg.utime;
@@ -334,6 +591,10 @@ semx::node_status_t Node::status() const {
   s.dropped = counters_.dropped;
   s.malformed = counters_.malformed;
   s.handler_errors = counters_.handler_errors;
+  s.foreign = counters_.foreign;
+  s.refused = counters_.refused;
+  s.lost = counters_.lost;
+  s.recovered = counters_.recovered;
   s.cpu_s = cpu_seconds();
   s.rss_kb = rss_kb();
   s.lockstep = options_.lockstep;
@@ -371,8 +632,13 @@ int Node::spin_once(int timeout_ms) {
   if (now >= next_status_) publish_status();
   const auto until_status = std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
-  if (udpm_) return receive_once(wait);
+  if (udpm_) {
+    const int got = receive_once(wait);
+    service_delivery();
+    return got;
+  }
   const int rc = lcm_->handleTimeout(wait);
+  service_delivery();
   if (rc < 0) return shutdown_requested() ? 0 : -1;  // a signal interrupting the wait is not a failure
   return rc > 0 ? 1 : 0;
 }
@@ -390,8 +656,7 @@ int Node::receive_once(int wait_ms) {
   if (!got) return 0;
   // liblcm calls a channel's handlers in the order they subscribed; the typed subscription of a
   // channel comes before any pattern here (SIM_CLOCK is subscribed in the constructor).
-  if (subs_.count(*m.channel)) on_message(*m.channel, m.data, m.size);
-  if (!raw_handlers_.empty()) on_raw_message(*m.channel, m.data, m.size);
+  if (subs_.count(*m.channel) || !raw_handlers_.empty()) on_signed_message(*m.channel, m.data, m.size);
   return 1;
 }
 

@@ -94,6 +94,7 @@ TEST(BenchScheduler, LaunchArgumentsAndOnePortPerSlot) {
             (std::vector<std::string>{"demo",      "--without",
                                       "logger",    "--no-color",
                                       "--lcm-url", "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304",
+                                      "--key-out", "/o/runs/env2-dep-s30-seed2/session.key",
                                       "--arg",     "world=env2",
                                       "--arg",     "planner=dep",
                                       "--arg",     "seed=2",

@@ -19,6 +19,7 @@
 #include <semx/odometry_t.hpp>
 #include <semx/path_t.hpp>
 #include <semx/planner_status_t.hpp>
+#include <semx/resend_t.hpp>
 #include <semx/rgb_image_t.hpp>
 #include <semx/roadmap_node_t.hpp>
 #include <semx/roadmap_t.hpp>
@@ -31,6 +32,6 @@
   X(ack_t)                                                                                                \
   X(camera_info_t) X(channel_stats_t) X(clock_t) X(control_cmd_t) X(controller_status_t) X(depth_image_t) \
       X(esdf_local_t) X(imu_t) X(label_image_t) X(map_request_t) X(map_snapshot_t) X(map_stats_t)         \
-          X(map_update_t) X(node_status_t) X(odometry_t) X(path_t) X(planner_status_t) X(rgb_image_t)     \
+          X(map_update_t) X(node_status_t) X(odometry_t) X(path_t) X(planner_status_t) X(resend_t) X(rgb_image_t)     \
               X(roadmap_node_t) X(roadmap_t) X(semantic_region_t) X(semantic_regions_t) X(sim_event_t)    \
                   X(trajectory_t)

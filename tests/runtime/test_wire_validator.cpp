@@ -111,7 +111,7 @@ TEST(WireValidator, NamesTheDefect) {
 TEST(WireValidator, RejectsBadStrings) {
   const auto& schema = LcmSchema::semx();
   const auto& type = *schema.find("semx.ack_t");
-  semx::ack_t a;
+  semx::ack_t a{};
   a.utime = 5;
   a.node = "mapper";
   a.tick = 7;

@@ -20,6 +20,7 @@
 
 #include "process_harness.hpp"
 #include "semx/runtime/lcm_url.hpp"
+#include "semx/runtime/message_auth.hpp"
 #include "semx/runtime/node.hpp"
 
 using namespace semx::testing;
@@ -79,9 +80,13 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
   std::size_t position = 0;
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
     ++position;
+    // The log keeps each message's trailer (docs/runtime.md, "Who may talk"); LCM reads before it.
+    const int n = static_cast<int>(
+        semx::runtime::payload_size(static_cast<const uint8_t*>(ev->data), static_cast<std::size_t>(ev->datalen)));
+    ASSERT_EQ(n + static_cast<int>(semx::runtime::kAuthTrailerBytes), ev->datalen) << ev->channel << " unsigned";
     if (ev->channel == "SIM_CLOCK") {
       semx::clock_t c;
-      ASSERT_EQ(c.decode(ev->data, 0, ev->datalen), ev->datalen);
+      ASSERT_EQ(c.decode(ev->data, 0, n), n);
       EXPECT_EQ(c.mode, semx::clock_t::LOCKSTEP);
       if (ticks.empty() || c.tick > ticks.back().first) {
         EXPECT_EQ(c.utime, c.tick * c.period_us);
@@ -89,12 +94,12 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
       }
     } else if (ev->channel == "SIM_ACK") {
       semx::ack_t a;
-      ASSERT_EQ(a.decode(ev->data, 0, ev->datalen), ev->datalen);
+      ASSERT_EQ(a.decode(ev->data, 0, n), n);
       EXPECT_EQ(a.node, "monitor");
       acked.emplace(a.tick, position);
     } else if (ev->channel == "NODE_STATUS") {
       semx::node_status_t s;
-      ASSERT_EQ(s.decode(ev->data, 0, ev->datalen), ev->datalen);
+      ASSERT_EQ(s.decode(ev->data, 0, n), n);
       status_nodes.insert(s.node);
     }
   }
@@ -156,7 +161,7 @@ TEST(Processes, LoggerRecordsABurstWholeAndLeavesOutWhatItExcludes) {
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
     const auto* d = static_cast<const uint8_t*>(ev->data);
     if (ev->channel == "SMALL") {
-      ASSERT_EQ(ev->datalen, 4);
+      ASSERT_EQ(semx::runtime::payload_size(d, static_cast<std::size_t>(ev->datalen)), 4u);
       small.push_back((d[0] << 24) | (d[1] << 16) | (d[2] << 8) | d[3]);
     } else if (ev->channel == "BIG") {
       ++bigs;
@@ -251,10 +256,16 @@ TEST(Processes, AKilledLockstepNodeIsRespawnedAndTheClockWaitsForIt) {
                         "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
                         "--max-speed, \"2\"]\n    start_delay: 0.5\n";
   const std::string out = temp_path("respawn.out");
-  Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color"}, out);
+  const std::string key = temp_path("respawn.key");
+  std::filesystem::remove(key);
+  Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--key-out", key}, out);
+  // The set's key, to hear its messages.
+  for (int i = 0; i < 200 && !std::filesystem::exists(key); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   semx::runtime::NodeOptions o;
   o.name = "respawn-test";
   o.lcm_url = url;
+  o.auth_key_file = key;
   o.follow_clock = false;
   o.quiet = true;
   semx::runtime::Node node(o);
@@ -332,12 +343,13 @@ TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
   EXPECT_EQ(launcher.wait(20), 0);
   EXPECT_NE(read_file(out).find(std::string("url=") + semx::runtime::kDefaultLcmUrl + "."), std::string::npos)
       << read_file(out);
-  // $LCM_DEFAULT_URL, when set, is what they get.
+  // $LCM_DEFAULT_URL, when set, is what they get, with the receive buffer it lacked (liblcm
+  // children would take the kernel's 208 KiB default and lose camera frames).
   setenv("LCM_DEFAULT_URL", "udpm://239.255.76.67:7999?ttl=0", 1);
   const std::string out2 = temp_path("url2.out");
   Process launcher2({bin("semx-launch"), set, "--no-color"}, out2);
   EXPECT_EQ(launcher2.wait(20), 0);
-  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0."), std::string::npos)
+  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0&recv_buf_size=4194304."), std::string::npos)
       << read_file(out2);
   if (saved)
     setenv("LCM_DEFAULT_URL", keep.c_str(), 1);
@@ -436,11 +448,15 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   Process recorder(
       {"/bin/bash", semx_cmd, "record", "--out", log, "--lcm-url", url, "--channels", "SIM_CLOCK"},
       temp_path("record.out"));
-  // The dependency check and the build come first (seconds on a loaded machine), then the logger
-  // creates its file and subscribes: a signal sent before that would reach bash, not the logger.
-  for (int i = 0; i < 600 && !std::filesystem::exists(log); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // The dependency check and build come first (seconds on a loaded machine): wait for the
+  // recorder's first heartbeat, which comes once it listens.
+  bool listening = false;
+  node.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t& s) {
+    listening |= s.node == "logger";
+  });
+  const auto ready_by = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!listening && std::chrono::steady_clock::now() < ready_by) node.spin_once(50);
+  ASSERT_TRUE(listening) << read_file(temp_path("record.out"));
   for (int i = 0; i < 50; ++i) {
     semx::clock_t c{};
     c.tick = i;

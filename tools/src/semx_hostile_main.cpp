@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     std::string channel, type_name, kinds = "all";
     int64_t count = 10, seed = 1;
     double rate = 200;
+    bool unsigned_ = false;
     ArgParser p("semx-hostile", "Publishes malformed messages on a channel (testing tool).");
     flags.add_to(p);
     p.option("channel", "NAME", "channel to attack (required)", &channel)
@@ -29,7 +30,11 @@ int main(int argc, char** argv) {
                 &kinds)
         .option("count", "N", "messages per kind (default 10)", &count)
         .option("rate", "HZ", "messages per second (default 200)", &rate)
-        .option("seed", "N", "random seed (default 1)", &seed);
+        .option("seed", "N", "random seed (default 1)", &seed)
+        .flag("unsigned",
+              "send without the set's trailer, as a process without its key would (every node drops them "
+              "before decoding); by default they are signed, so the nodes' decoders and checks see them",
+              &unsigned_);
     if (!p.parse(argc, argv)) return 0;
     if (channel.empty()) throw ArgError("--channel is required");
     if (!(rate > 0)) throw ArgError("--rate must be positive");
@@ -54,6 +59,7 @@ int main(int argc, char** argv) {
 
     auto options = flags.options();
     options.follow_clock = false;
+    options.sign = !unsigned_;
     Node node(options);
     std::mt19937_64 rng(static_cast<uint64_t>(seed));
     const auto period = std::chrono::duration<double>(1.0 / rate);

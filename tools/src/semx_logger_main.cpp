@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
       } else if (failed++ == 0) {
         std::cerr << "semx-logger: " << file << ": write failed (disk full?); later events are counted\n";
       }
-    });
+    }, /*with_trailer=*/true);
     node.never_wanted(selection.refused_known());
     const int rc = node.run();
     node.drain();  // what arrived before the signal is part of the run

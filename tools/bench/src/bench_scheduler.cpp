@@ -21,6 +21,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/lcm_url.hpp"
 
 namespace semx::bench {
 
@@ -214,9 +215,8 @@ std::string slot_lcm_url(const std::string& base_url, int slot, int port) {
   if (base + slot > 65535) {
     throw runtime::ArgError("LCM port " + std::to_string(base) + " + slot " + std::to_string(slot) + " is past 65535");
   }
-  if (("&" + opts).find("&recv_buf_size=") == std::string::npos)
-    opts += (opts.empty() ? "" : "&") + std::string("recv_buf_size=4194304");
-  return address.substr(0, colon + 1) + std::to_string(base + slot) + "?" + opts;
+  return runtime::with_receive_buffer(address.substr(0, colon + 1) + std::to_string(base + slot) +
+                                     (opts.empty() ? "" : "?" + opts));
 }
 
 std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::string& dir,
@@ -225,7 +225,9 @@ std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::s
   // Without logs, no logger either: it reads every message of the run only to write a log the
   // bench would delete.
   if (!o.keep_logs) argv.insert(argv.end(), {"--without", "logger"});
-  argv.insert(argv.end(), {"--no-color", "--lcm-url", slot_lcm_url(o.base_url, slot)});
+  // The run's key stays in its folder, so its log can be checked and replayed (./semx eval).
+  argv.insert(argv.end(), {"--no-color", "--lcm-url", slot_lcm_url(o.base_url, slot), "--key-out",
+                           dir + "/session.key"});
   for (const std::string& a :
        {"world=" + run.world, "planner=" + run.planner, "seed=" + std::to_string(run.seed),
         "samples=" + run.samples, "clock=" + o.clock, "time_limit=" + run.time_limit, "out=" + dir,

@@ -10,7 +10,7 @@ using namespace semx;
 
 int main(int argc, char** argv) {
   return runtime::run_main("semx-eval", [&] {
-    std::string log, world, out, planner;
+    std::string log, world, out, planner, auth_key;
     int64_t seed = -1, samples = -1;
     double time_limit = 0, resolution = 0.1, sample_period = 1.0;
     bool any_world = false;
@@ -27,6 +27,10 @@ int main(int argc, char** argv) {
                 "EPISODE_START names)",
                 &world)
         .flag("any-world", "evaluate against --world even when the log names another world", &any_world)
+        .option("auth-key", "FILE",
+                "the run's key, to check every event (default: session.key beside the log, if any; "
+                "else the events of the set that sent the log's first EPISODE_START)",
+                &auth_key)
         .option("out", "DIR", "run folder to write (default: none, only the table)", &out)
         .option("time-limit", "S", "end the run after S simulated seconds (default: the log's end)",
                 &time_limit)
@@ -47,6 +51,7 @@ int main(int argc, char** argv) {
     o.log_path = log;
     o.world = world;
     o.any_world = any_world;
+    o.auth_key_file = auth_key;
     o.evaluation.info.planner = planner;
     if (seed >= 0) o.evaluation.info.seed = seed;
     if (samples >= 0) o.evaluation.info.samples = samples;
@@ -63,6 +68,7 @@ int main(int argc, char** argv) {
       for (const auto& [channel, n] : r.channels) {
         std::printf("  %-20s %lld\n", channel.c_str(), static_cast<long long>(n));
       }
+      if (!r.left_out.empty()) std::printf("semx-eval: warning: %s\n", r.left_out.c_str());
       if (r.malformed > 0) {
         std::printf("semx-eval: %lld malformed events skipped (first: %s)\n",
                     static_cast<long long>(r.malformed), r.first_error.c_str());

@@ -122,8 +122,10 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
     }
     regions_ = std::move(regions);
   });
-  // Who of the set restarted, and when: a disturbed run is marked so in metrics.json.
+  // Who of the set restarted, and when (a disturbed run is marked so in metrics.json), and each
+  // node's messages lost for good.
   node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& m) {
+    if (m.lost > 0) lost_[m.node] = std::max(lost_[m.node], m.lost);
     const int64_t t = std::max(node_.now_utime(), evaluation_.metrics().now_utime());
     const size_t before = evaluation_.restarts().size();
     evaluation_.on_node_status(m.node, m.pid, m.restarts, t);
@@ -243,9 +245,26 @@ void EvaluatorNode::progress(int64_t utime) {
   node_.set_state(runtime::NodeState::kRunning, line);
 }
 
+void EvaluatorNode::check_validity() {
+  if (node_.counters().lost > 0) lost_[node_.name()] = node_.counters().lost;
+  std::string lost;
+  int64_t total = 0;
+  for (const auto& [name, n] : lost_) {
+    lost += (lost.empty() ? "" : ", ") + name + " " + std::to_string(n);
+    total += n;
+  }
+  if (total > 0) evaluation_.mark_invalid(std::to_string(total) + " messages lost for good (" + lost + ")");
+  const int64_t gaps = map_.has_mirror() ? map_.mirror().counters().gaps : 0;
+  if (gaps > 0) {
+    evaluation_.mark_invalid(std::to_string(gaps) +
+                             " gaps in the MAP_UPDATE sequence (the map was resynchronised from snapshots)");
+  }
+}
+
 void EvaluatorNode::finish_at(Termination why, int64_t utime) {
   if (finished()) return;
   wall_end_ = wall_now();
+  check_validity();
   evaluation_.finish(why, utime, wall_s());
   write_folder();
   const RunSummary s = evaluation_.summary();
@@ -255,14 +274,10 @@ void EvaluatorNode::finish_at(Termination why, int64_t utime) {
     if (!written_.empty()) {
       std::printf("semx-evaluator: run folder %s\n", options_.out_dir.c_str());
     }
-    // Lost MAP_UPDATEs: the mirror waited for snapshots, so the coverage curve has steps another
-    // run of the seed would not have.
-    const int64_t gaps = map_.has_mirror() ? map_.mirror().counters().gaps : 0;
-    if (gaps > 0) {
-      std::printf(
-          "semx-evaluator: warning: %lld gaps in the MAP_UPDATE sequence (lost messages; "
-          "the map was resynchronised from snapshots): this run may not reproduce\n",
-          static_cast<long long>(gaps));
+    if (!s.valid) {
+      std::printf("\033[31msemx-evaluator: this run is NOT VALID: %s. Its figures are not the ones the seed "
+                  "gives; the bench leaves it out of its tables.\033[0m\n",
+                  s.invalid_reason.c_str());
     }
     std::fflush(stdout);
   }

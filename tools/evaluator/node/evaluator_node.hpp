@@ -12,6 +12,7 @@
 #pragma once
 
 #include <memory>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,10 @@ class EvaluatorNode {
   bool write_failed_ = false;
   RoadmapOverlay roadmap_;              // the planner's last ROADMAP
   std::vector<RegionOverlay> regions_;  // the last SEMANTIC_REGIONS
+  // Each node's messages lost for good, from its NODE_STATUS (and this node's own): a run where
+  // any were is not the seed's run.
+  std::map<std::string, int64_t> lost_;
+  void check_validity();
   std::unique_ptr<runtime::StateJournal> journal_;
   Evaluation::Saved saved_;
   size_t saved_samples_ = 0;

@@ -36,7 +36,7 @@ namespace {
 // Validates and decodes one event as T, as a live subscription would. False with `why` set when
 // the bytes are not a usable T.
 template <class T>
-bool decode_event(const lcm::LogEvent& e, T& out, std::string& why) {
+bool decode_event(const lcm::LogEvent& e, std::size_t size, T& out, std::string& why) {
   const auto& schema = runtime::LcmSchema::semx();
   const runtime::LcmStruct* type = schema.find(std::string("semx.") + T::getTypeName());
   if (!type) {
@@ -44,7 +44,6 @@ bool decode_event(const lcm::LogEvent& e, T& out, std::string& why) {
     return false;
   }
   const auto* data = static_cast<const uint8_t*>(e.data);
-  const auto size = static_cast<size_t>(e.datalen);
   const runtime::WireError we = runtime::validate_wire(schema, *type, T::getHash(), data, size);
   if (we != runtime::WireError::kNone) {
     why = runtime::to_string(we);
@@ -76,7 +75,8 @@ std::string world_stem(const std::string& path) { return fs::path(path).stem().s
 
 }  // namespace
 
-std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout) {
+std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout,
+                               runtime::LogSession& session) {
   lcm::LogFile log(log_path, "r");
   if (!log.good()) return "";
   std::string why;
@@ -84,8 +84,14 @@ std::string world_named_in_log(const std::string& log_path, const runtime::LogLa
     const lcm::LogEvent* e = log.readNextEvent();
     if (!e) break;
     if (e->channel != ch::SIM_EVENT) continue;
+    // By session only, not through session.payload(): its replay window is for the real pass.
+    const auto* data = static_cast<const uint8_t*>(e->data);
+    const auto size = static_cast<std::size_t>(e->datalen);
+    const auto trailer = runtime::read_trailer(data, size);
+    if (session.signed_log() && (!trailer || trailer->session != session.session())) continue;
+    const std::size_t payload = trailer ? size - runtime::kAuthTrailerBytes : size;
     semx::sim_event_t ev{};
-    if (decode_event(*e, ev, why) && ev.type == semx::sim_event_t::EPISODE_START) return ev.description;
+    if (decode_event(*e, payload, ev, why) && ev.type == semx::sim_event_t::EPISODE_START) return ev.description;
   }
   return "";
 }
@@ -96,8 +102,17 @@ LogEvaluator::LogEvaluator(LogEvalOptions options) : options_(std::move(options)
   } catch (const runtime::LogError& e) {
     throw LogEvalError(e.what());
   }
+  std::optional<runtime::AuthKey> key;
+  try {
+    key = options_.auth_key_file.empty() ? runtime::key_beside(options_.log_path)
+                                         : runtime::AuthKey::from_file(options_.auth_key_file);
+    session_ = std::make_unique<runtime::LogSession>(options_.log_path, report_.layout, key);
+  } catch (const std::exception& e) {
+    throw LogEvalError(e.what());
+  }
+  report_.verified = session_->verified();
   std::string world = options_.world;
-  const std::string logged = world_named_in_log(options_.log_path, report_.layout);
+  const std::string logged = world_named_in_log(options_.log_path, report_.layout, *session_);
   if (world.empty()) {
     world = logged;
     if (world.empty()) {
@@ -186,6 +201,10 @@ void LogEvaluator::run() {
     const lcm::LogEvent* e = log.readNextEvent();
     if (!e) throw LogEvalError(options_.log_path + ": lcm::LogFile stopped at event " + std::to_string(i));
     why.clear();
+    const auto payload =
+        session_->payload(e->channel, static_cast<const uint8_t*>(e->data), static_cast<std::size_t>(e->datalen));
+    if (!payload) continue;
+    const std::size_t n = *payload;
     ++report_.events_read;
     ++report_.channels[e->channel];
     const std::string& c = e->channel;
@@ -199,7 +218,7 @@ void LogEvaluator::run() {
     }
     if (c == ch::SIM_CLOCK) {
       semx::clock_t clock{};
-      if (!decode_event(*e, clock, why)) {
+      if (!decode_event(*e, n, clock, why)) {
         bad(i, c, why);
         continue;
       }
@@ -213,7 +232,7 @@ void LogEvaluator::run() {
     } else if (c == ch::MAP_UPDATE) {
       Held h;
       semx::map_update_t update{};
-      if (!decode_event(*e, update, why) || !map::accept_update(update) ||
+      if (!decode_event(*e, n, update, why) || !map::accept_update(update) ||
           !map::from_message(update, h.delta)) {
         bad(i, c, why.empty() ? "content rejected" : why);
         continue;
@@ -228,7 +247,7 @@ void LogEvaluator::run() {
     } else if (c == ch::MAP_SNAPSHOT) {
       Held h;
       semx::map_snapshot_t snapshot{};
-      if (!decode_event(*e, snapshot, why) || !map::accept_snapshot(snapshot)) {
+      if (!decode_event(*e, n, snapshot, why) || !map::accept_snapshot(snapshot)) {
         bad(i, c, why.empty() ? "content rejected" : why);
         continue;
       }
@@ -243,7 +262,7 @@ void LogEvaluator::run() {
       }
     } else if (c == ch::ODOMETRY) {
       semx::odometry_t odometry{};
-      if (!decode_event(*e, odometry, why) || !finite3(odometry.position)) {
+      if (!decode_event(*e, n, odometry, why) || !finite3(odometry.position)) {
         bad(i, c, why.empty() ? "position not finite" : why);
         continue;
       }
@@ -252,7 +271,7 @@ void LogEvaluator::run() {
                      Eigen::Vector3d(odometry.position[0], odometry.position[1], odometry.position[2]));
     } else if (c == ch::SIM_EVENT) {
       semx::sim_event_t event{};
-      if (!decode_event(*e, event, why)) {
+      if (!decode_event(*e, n, event, why)) {
         bad(i, c, why);
         continue;
       }
@@ -265,7 +284,7 @@ void LogEvaluator::run() {
       if (event.type == semx::sim_event_t::COLLISION) ev.on_collision(event.utime, event.count);
     } else if (c == ch::PLANNER_STATUS) {
       semx::planner_status_t status{};
-      if (!decode_event(*e, status, why)) {
+      if (!decode_event(*e, n, status, why)) {
         bad(i, c, why);
         continue;
       }
@@ -273,6 +292,7 @@ void LogEvaluator::run() {
       ev.on_planner_status(status.utime, status.planner, planner_state_from_int(status.state), status.reason);
     }
   }
+  report_.left_out = session_->summary();
   flush(std::numeric_limits<int64_t>::max());
   if (!ev.finished()) ev.finish(Termination::kLogEnd, ev.metrics().now_utime(), report_.log_wall_s);
 }

@@ -18,6 +18,7 @@
 #include "semx/evaluator/evaluation.hpp"
 #include "semx/map/map_mirror.hpp"
 #include "semx/runtime/log_scan.hpp"
+#include "semx/runtime/log_session.hpp"
 
 namespace semx::evaluator {
 
@@ -34,6 +35,9 @@ struct LogEvalOptions {
   // coverage of one world's log against another's truth is a number that means nothing), unless
   // this is set.
   bool any_world = false;
+  // The run's key, to check every event's tag; "" takes session.key beside the log if there is
+  // one, else reads the session of the log's first EPISODE_START unchecked (log_session.hpp).
+  std::string auth_key_file;
   EvaluationOptions evaluation;  // info (planner, seed, samples), time limit, resolution
 };
 
@@ -46,6 +50,8 @@ struct LogEvalReport {
   bool clock = false;       // the log has SIM_CLOCK
   int64_t map_gaps = 0;     // times the mirror lost the sequence (needs a snapshot)
   double log_wall_s = 0.0;  // logger time from the first event to the last one read
+  bool verified = false;    // every event's tag checked with the run's key
+  std::string left_out;     // another set's or refused events (LogSession::summary), "" if none
 };
 
 class LogEvaluator {
@@ -81,11 +87,14 @@ class LogEvaluator {
   std::unique_ptr<map::MapMirror> mirror_;
   std::unique_ptr<map::StateGrid> empty_;
   std::vector<Held> held_;
+  std::unique_ptr<runtime::LogSession> session_;
   LogEvalReport report_;
   bool ran_ = false;
 };
 
-// The world a log names: the description of its first SIM_EVENT EPISODE_START ("" if none).
-std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout);
+// The world a log names: the description of its first SIM_EVENT EPISODE_START of the run's
+// session ("" if none).
+std::string world_named_in_log(const std::string& log_path, const runtime::LogLayout& layout,
+                               runtime::LogSession& session);
 
 }  // namespace semx::evaluator

@@ -183,6 +183,8 @@ BenchRun load_bench_run(const std::string& dir) {
   r.world = text("world");
   r.planner = text("planner");
   r.termination = text("termination");
+  if (m["valid"] && m["valid"].IsScalar()) r.valid = m["valid"].as<bool>();
+  r.invalid_reason = text("invalid_reason");
   if (r.world.empty() || r.planner.empty()) throw std::runtime_error(file + ": no world or planner");
   r.seed = m["seed"] && !m["seed"].IsNull() ? m["seed"].as<int64_t>() : 0;
   r.samples = m["samples"] && !m["samples"].IsNull() ? m["samples"].as<int>() : 0;
@@ -261,9 +263,45 @@ void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptio
   }
 }
 
+// The runs the tables summarise: valid (no message lost or mixed) and undisturbed (no process
+// restarted during the run).
+static std::vector<BenchRun> tabled_only(const std::vector<BenchRun>& runs) {
+  std::vector<BenchRun> out;
+  for (const auto& r : runs)
+    if (r.valid && !r.disturbed) out.push_back(r);
+  return out;
+}
+
+static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o);
+
 std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOptions& o) {
-  std::vector<BenchRun> runs, disturbed;
-  for (const auto& r : all) (r.disturbed ? disturbed : runs).push_back(r);
+  std::string md = tables_markdown(tabled_only(all), o);
+  std::string left_out;
+  for (const auto& r : all) {
+    if (r.valid || r.disturbed) continue;  // a disturbed run is listed with the disturbed ones
+    left_out += "- " + r.dir + " (" + r.world + ", " + r.planner + ", seed " + std::to_string(r.seed) + "): " +
+                r.invalid_reason + "\n";
+  }
+  if (!left_out.empty()) {
+    md += "\n### Runs left out of the tables (not valid: lost or mixed messages)\n\n" + left_out;
+  }
+  std::ostringstream d;
+  for (const auto& r : all) {
+    if (!r.disturbed) continue;
+    d << "| " << r.world << " | " << r.planner << " | " << r.samples << " | " << r.seed << " | "
+      << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | " << fmt(r.coverage_pct, 2)
+      << " | " << r.termination << " | " << (r.valid ? "" : r.invalid_reason) << " | " << r.dir << " |\n";
+  }
+  if (!d.str().empty()) {
+    md += "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
+          "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
+          "termination | not valid | folder |\n|---|---|---|---|---|---|---|---|---|---|\n" +
+          d.str();
+  }
+  return md;
+}
+
+static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o) {
   std::ostringstream md;
   const auto worlds = worlds_of(runs);
   std::set<int> densities;
@@ -391,17 +429,6 @@ std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOp
   md << "\n"
      << runs.size() << " runs, " << fmt(sim, 0) << " simulated s in " << fmt(wall, 0)
      << " wall s of exploration (" << fmt(wall > 0 ? sim / wall : 0, 1) << "x real time).\n";
-  if (!disturbed.empty()) {
-    md << "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
-       << "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
-          "termination | folder |\n"
-       << "|---|---|---|---|---|---|---|---|---|\n";
-    for (const auto& r : disturbed) {
-      md << "| " << r.world << " | " << r.planner << " | " << r.samples << " | " << r.seed << " | "
-         << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | "
-         << fmt(r.coverage_pct, 2) << " | " << r.termination << " | " << r.dir << " |\n";
-    }
-  }
   return md.str();
 }
 
@@ -426,9 +453,7 @@ std::string bench_csv(const std::vector<BenchRun>& runs) {
 
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, const std::string& dir,
                                            const BenchReportOptions& o) {
-  std::vector<BenchRun> runs;
-  for (const auto& r : all)
-    if (!r.disturbed) runs.push_back(r);
+  const std::vector<BenchRun> runs = tabled_only(all);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
     std::vector<const BenchRun*> here;

@@ -111,8 +111,16 @@ void Evaluation::finish(Termination why, int64_t utime, double wall_s) {
   metrics_.finish(why, utime, options_.time_limit_s);
 }
 
+void Evaluation::mark_invalid(const std::string& reason) {
+  for (const auto& r : invalid_reasons_)
+    if (r == reason) return;
+  invalid_reasons_.push_back(reason);
+}
+
 RunSummary Evaluation::summary() const {
   RunSummary s;
+  s.valid = invalid_reasons_.empty();
+  for (const auto& r : invalid_reasons_) s.invalid_reason += (s.invalid_reason.empty() ? "" : "; ") + r;
   s.info = options_.info;
   s.info.planner = planner_;
   s.time_f_s = metrics_.time_f_s();

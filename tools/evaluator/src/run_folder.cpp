@@ -113,6 +113,8 @@ std::string metrics_json(const RunSummary& s) {
   field("collisions", std::to_string(s.collisions));
   field("wall_s", number(s.wall_s));
   field("termination", json_string(s.termination));
+  field("valid", s.valid ? "true" : "false");
+  field("invalid_reason", json_string(s.invalid_reason));
   field("planner_state", json_string(s.planner_state));
   field("planner_reason", json_string(s.planner_reason));
   field("sim_s", number(s.sim_s));
@@ -252,6 +254,7 @@ std::string format_metrics_table(const RunSummary& s) {
   row("planner", planner);
   row("ended", s.termination + " (planner " + s.planner_state +
                    (s.planner_reason.empty() ? "" : ": " + s.planner_reason) + ")");
+  if (!s.valid) row("NOT VALID", "\033[31m" + s.invalid_reason + " (left out of the bench's tables)\033[0m");
   row("Time_f", fmt("%.2f s", s.time_f_s));
   row("Distance", fmt("%.2f m", s.distance_m));
   row("Coverage", fmt("%.2f %%", s.coverage_pct) + "  (" + std::to_string(s.covered_voxels) + " of " +

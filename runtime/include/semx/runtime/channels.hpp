@@ -9,6 +9,7 @@
 #define SEMX_CHANNELS(X)                    \
   X(SIM_CLOCK, clock_t)                     \
   X(SIM_ACK, ack_t)                         \
+  X(SIM_RESEND, resend_t)                   \
   X(SIM_EVENT, sim_event_t)                 \
   X(ODOMETRY, odometry_t)                   \
   X(IMU, imu_t)                             \

@@ -15,18 +15,24 @@
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/node_status_t.hpp>
+#include <semx/resend_t.hpp>
 
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "semx/runtime/channel_pattern.hpp"
+#include "semx/runtime/delivery.hpp"
 #include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/message_auth.hpp"
 #include "semx/runtime/restart_count.hpp"
 #include "semx/runtime/sim_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
@@ -52,6 +58,12 @@ struct NodeOptions {
   // status_period_s: a process started at the same time (the lockstep simulator, which waits to
   // hear every node it must wait for) hears this one within a fraction of a second, not a period.
   bool announce = false;
+  // The set's key file (--auth-key); empty: SEMX_AUTH_KEY / SEMX_AUTH_KEY_FILE, else the open
+  // session (message_auth.hpp).
+  std::string auth_key_file;
+  // Off only for tools that play an outsider (semx-hostile --unsigned): messages go out without a
+  // trailer, and every semx node drops them.
+  bool sign = true;
   // How often the launcher restarted this process (restart_count.hpp), reported in NODE_STATUS.
   int restarts = restart_count();
 };
@@ -63,6 +75,8 @@ struct ChannelCounters {
   int64_t dropped = 0;
   int64_t bytes = 0;
   int64_t skipped = 0;  // refused by a skip_unless() filter before decoding (not malformed)
+  int64_t foreign = 0;  // another set's messages (another session on the same bus)
+  int64_t refused = 0;  // unsigned, forged or replayed
 };
 
 struct NodeCounters {
@@ -71,6 +85,11 @@ struct NodeCounters {
   int64_t dropped = 0;    // includes messages whose fragments did not all arrive
   int64_t malformed = 0;  // includes datagrams that are not LCM's (udpm_receiver.hpp)
   int64_t handler_errors = 0;
+  int64_t foreign = 0;  // another set's messages, ignored
+  int64_t refused = 0;  // unsigned, forged or replayed messages, dropped
+  int64_t lost = 0;       // messages missed and given up on (delivery.hpp): the run is not exact
+  int64_t recovered = 0;  // messages missed and received again after a SIM_RESEND
+  int64_t resent = 0;     // messages this node sent again on request
 };
 
 enum class NodeState : int8_t {
@@ -112,9 +131,12 @@ class Node {
   // counted (ChannelCounters::skipped) and dropped before it is validated or decoded. Messages
   // too short to hold a utime go through the normal checks.
   void skip_unless(const std::string& channel, std::function<bool(int64_t utime)> wanted);
-  // Raw bytes of every channel matching `regex` (tools: monitors, recorders).
+  // Raw bytes of every channel matching `regex` (tools: monitors, recorders): the payload LCM's
+  // decoders read, or with `with_trailer` the message as it came (a recorder keeps the trailer,
+  // so a log replayed with the run's key is accepted again). Only this set's authenticated
+  // messages reach it, as they reach typed subscriptions.
   using RawHandler = std::function<void(const std::string& channel, const uint8_t* data, std::size_t size)>;
-  void subscribe_raw(const std::string& regex, RawHandler handler);
+  void subscribe_raw(const std::string& regex, RawHandler handler, bool with_trailer = false);
   // With a pattern subscription every channel reaches this process; these exact channels, which
   // its handlers ignore anyway (a recorder's exclusions), the kernel may drop before they do.
   void never_wanted(std::vector<std::string> channels);
@@ -174,6 +196,10 @@ class Node {
   const std::map<std::string, ChannelCounters>& outgoing() const { return outgoing_; }
   semx::node_status_t status() const;
   void publish_status();
+  // The set this node belongs to (message_auth.hpp) and its own sender id.
+  uint64_t session() const { return verifier_.session(); }
+  uint64_t sender() const { return signer_.sender(); }
+  bool open_session() const { return key_.is_open(); }
 
  private:
   struct Subscription;
@@ -184,13 +210,30 @@ class Node {
   void ensure_lcm_subscription(const std::string& channel);
   void on_lcm_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void on_lcm_raw_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  // Every message that arrives: its trailer is checked, then it goes to the typed and raw handlers.
+  void on_signed_message(const std::string& channel, const uint8_t* data, std::size_t size);
   void on_message(const std::string& channel, const uint8_t* data, std::size_t size);
-  void on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size);
+  void on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size,
+                      std::size_t payload);
+  void note_refused(const std::string& channel, AuthVerdict verdict, const AuthTrailer& trailer);
+  // Signs `bytes` (the payload) in place and sends it.
+  bool send_signed(const std::string& channel, std::vector<uint8_t>& bytes);
   // Own receiver: opens it on the first subscription and keeps its kernel filter current.
   void update_receiver();
   int receive_once(int wait_ms);
   void note_receiver_problems();
   void on_clock_message(const semx::clock_t& msg);
+  // The tick's work and ack, once everything its heads name is held.
+  void handle_tick(const semx::clock_t& msg);
+  // Resend requests, given-up gaps, held ticks whose messages all arrived.
+  void service_delivery();
+  // Hands a message to the typed subscriptions (`payload` bytes) and raw ones (`size` bytes).
+  void dispatch(const std::string& channel, const uint8_t* data, std::size_t size, std::size_t payload);
+  void deliver_ready();
+  void on_resend_request(const semx::resend_t& r);
+  // The clock's source: its SIM_CLOCK carries every publisher's heads.
+  bool publish_clock(const std::string& channel, const semx::clock_t& msg);
+  std::vector<std::pair<int32_t, int32_t>> own_heads() const;
   void note_malformed(const std::string& channel, const std::string& why, std::size_t size);
   void note_handler_error(const std::string& channel, const char* what);
   const LcmStruct& schema_of(const char* type_name) const;
@@ -201,6 +244,7 @@ class Node {
   struct RawSubscription {
     ChannelPattern pattern;
     RawHandler handler;
+    bool with_trailer = false;
   };
   std::vector<RawSubscription> raw_handlers_;
   std::optional<UdpmEndpoint> udpm_;
@@ -211,6 +255,23 @@ class Node {
   ReassemblyCounters receiver_seen_;  // what the counters already hold of the receiver's
   std::map<std::string, std::function<bool(int64_t)>> skip_filters_;
   std::vector<uint8_t> encode_buffer_;
+  std::vector<uint8_t> publish_buffer_;  // publish_raw's copy, with room for the trailer
+  AuthKey key_;
+  MessageSigner signer_;
+  MessageVerifier verifier_;
+  Inbox inbox_;
+  ResendHistory history_;
+  std::vector<uint8_t> resend_buffer_;
+  std::deque<semx::clock_t> held_ticks_;  // ticks waiting for messages their heads name
+  struct AckHeads {
+    int64_t sender = 0;
+    std::vector<std::pair<int32_t, int32_t>> heads;  // (tag, seq)
+  };
+  std::map<std::string, AckHeads> ack_heads_;  // clock source: each node's latest ack
+  bool clock_source_ = false;
+  bool from_log_ = false;                // file:// provider: a log played back (on_signed_message)
+  std::optional<uint64_t> log_session_;  // the one set read from it
+  bool in_publish_clock_ = false;
   std::vector<std::function<void(int64_t, int64_t)>> tick_handlers_;
   std::function<int64_t(int64_t)> quiet_until_fn_;
   std::vector<std::function<void()>> after_ack_;
@@ -290,8 +351,12 @@ void Node::subscribe(const std::string& channel, std::function<void(const T&)> h
 
 template <class T>
 bool Node::publish(const std::string& channel, const T& msg) {
+  if constexpr (std::is_same_v<T, semx::clock_t>) {
+    if (!in_publish_clock_) return publish_clock(channel, msg);
+  }
   const int size = msg.getEncodedSize();
   if (size < 0) return false;
+  encode_buffer_.reserve(static_cast<std::size_t>(size) + kAuthTrailerBytes);
   encode_buffer_.resize(static_cast<std::size_t>(size));
   if (msg.encode(encode_buffer_.data(), 0, size) != size) {
     auto& c = outgoing_[channel];
@@ -300,7 +365,7 @@ bool Node::publish(const std::string& channel, const T& msg) {
     ++counters_.dropped;
     return false;
   }
-  return publish_raw(channel, encode_buffer_.data(), encode_buffer_.size());
+  return send_signed(channel, encode_buffer_);
 }
 
 }  // namespace semx::runtime

@@ -15,6 +15,7 @@ struct NodeFlags {
   bool lockstep = false;
   double status_period_s = 1.0;
   bool quiet = false;
+  std::string auth_key_file;
 
   explicit NodeFlags(std::string default_name) : name(std::move(default_name)) {}
 
@@ -24,7 +25,11 @@ struct NodeFlags {
         .flag("lockstep", "ack every SIM_CLOCK tick: the clock waits for this node", &lockstep)
         .option("status-period", "S", "NODE_STATUS heartbeat period in wall seconds (default 1)",
                 &status_period_s)
-        .flag("quiet", "do not log dropped or malformed messages", &quiet);
+        .flag("quiet", "do not log dropped or malformed messages", &quiet)
+        .option("auth-key", "FILE",
+                "the set's key (64 hex digits; default: $SEMX_AUTH_KEY or $SEMX_AUTH_KEY_FILE, which the "
+                "launcher sets; without any, the open session that only processes without a key share)",
+                &auth_key_file);
   }
 
   NodeOptions options() const {
@@ -35,6 +40,7 @@ struct NodeFlags {
     o.lockstep = lockstep;
     o.status_period_s = status_period_s;
     o.quiet = quiet;
+    o.auth_key_file = auth_key_file;
     o.announce = true;  // processes started together by a launcher find each other at once
     return o;
   }

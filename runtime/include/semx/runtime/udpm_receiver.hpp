@@ -26,8 +26,12 @@ struct UdpmEndpoint {
   std::string group;
   int port = 0;
   int ttl = 0;            // 0: nothing leaves the host
-  int recv_buf_size = 0;  // 0: the kernel's default
+  int recv_buf_size = 0;  // 0: kDefaultRecvBufBytes
 };
+
+// A receiver's buffer when the URL names none: a burst of 1 MB camera frames and map messages
+// within the lockstep clock's slack must fit.
+inline constexpr int kDefaultRecvBufBytes = 4 << 20;
 
 // The endpoint of a udpm URL; nullopt for any other provider and for URLs this parser does not
 // understand (liblcm's own receiver then takes them as before).
@@ -65,6 +69,17 @@ class UdpmReceiver {
   const ReassemblyCounters& counters() const { return reassembler_.counters(); }
   DatagramError last_error() const { return last_error_; }
   int64_t socket_errors() const { return socket_errors_; }
+  // The receive buffer asked for and the one the kernel granted (after SO_RCVBUFFORCE, which only
+  // root may use): less than asked means bursts are dropped by the kernel.
+  int requested_recv_buf() const { return requested_recv_buf_; }
+  // For tests of a lossy bus: drops each datagram with probability `rate` (seeded), as a lossy
+  // network would, before reassembly. Node sets it from SEMX_TEST_DROP_RATE.
+  void drop_for_test(double rate, uint64_t seed) {
+    drop_rate_ = rate;
+    drop_state_ = seed * 0x9E3779B97F4A7C15ull + 1;
+  }
+  int64_t dropped_for_test() const { return dropped_for_test_; }
+  int granted_recv_buf() const { return granted_recv_buf_; }
 
  private:
   int fd_ = -1;
@@ -72,6 +87,11 @@ class UdpmReceiver {
   LcmReassembler reassembler_;
   DatagramError last_error_ = DatagramError::kNone;
   int64_t socket_errors_ = 0;
+  int requested_recv_buf_ = 0;
+  double drop_rate_ = 0;
+  uint64_t drop_state_ = 1;
+  int64_t dropped_for_test_ = 0;
+  int granted_recv_buf_ = 0;
   std::string name_;
 };
 

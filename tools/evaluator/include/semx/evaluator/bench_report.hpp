@@ -25,6 +25,8 @@ struct BenchRun {
   std::optional<double> end_game_s;      // time_f_s - time_settled_s
   std::optional<double> object_coverage_pct;
   int64_t collisions = 0;
+  bool valid = true;           // metrics.json "valid" (a run folder from before it: true)
+  std::string invalid_reason;  // why not
   std::vector<std::pair<double, double>> coverage;  // (t s, %)
   // A process of the set was restarted during the run (metrics.json "disturbed"): listed under
   // the tables, never in them; `restarts` says which and when ("mapper 12.3 s, ...").
@@ -49,7 +51,7 @@ struct BenchReportOptions {
   double threshold_pct = 85.0;
 };
 
-// Markdown (disturbed runs are left out of every table and listed after them): the sweep table, the comparison table (with Time_95, the end game and Time_o, the
+// Markdown: (only the valid, undisturbed runs; the others are listed under the tables) the sweep table, the comparison table (with Time_95, the end game and Time_o, the
 // objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
 // the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
 // baseline (Time_f, Time_r, Time_o, Distance, in %), each world in the order the runs name them.

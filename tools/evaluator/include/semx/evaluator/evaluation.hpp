@@ -87,6 +87,11 @@ class Evaluation {
   int64_t map_deltas() const { return map_deltas_; }
   int64_t map_resets() const { return map_resets_; }
 
+  // The run's figures are not the ones an exact run gives (messages lost on the way, map gaps):
+  // written as "valid": false with the reasons, and left out of the bench's tables.
+  void mark_invalid(const std::string& reason);
+  bool valid() const { return invalid_reasons_.empty(); }
+
   RunSummary summary() const;
 
   // ---- saved state (semx-evaluator's --state journal) ----
@@ -112,6 +117,7 @@ class Evaluation {
   int64_t map_resets_ = 0;
   int64_t map_seq_ = 0;
   double wall_s_ = 0.0;
+  std::vector<std::string> invalid_reasons_;
   struct NodeSeen {
     int pid = 0;
     int restarts = 0;

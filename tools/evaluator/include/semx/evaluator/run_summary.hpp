@@ -44,6 +44,10 @@ struct RunSummary {
   double object_coverage_pct = 0.0;
   std::optional<double> time_o_s;
   int64_t collisions = 0;
+  // False when the run lost or mixed messages (Evaluation::mark_invalid): its figures are not the
+  // ones the seed gives, and the bench leaves it out of its tables.
+  bool valid = true;
+  std::string invalid_reason;
   double wall_s = 0.0;  // wall-clock s from the first SIM_CLOCK, ODOMETRY or MAP_UPDATE to the end
   // Context.
   std::string termination;             // to_string(Termination)

@@ -1,0 +1,144 @@
+#include "semx/runtime/delivery.hpp"
+
+#include <algorithm>
+
+namespace semx::runtime {
+
+void Inbox::reads(uint32_t tag) {
+  if (tags_.insert(tag).second && ticked_) fresh_tags_.insert(tag);
+}
+
+Inbox::Arrival Inbox::arrive(const StreamKey& s, uint32_t seq, const std::string& channel, const uint8_t* bytes,
+                             std::size_t size, double now) {
+  if (s.sender == self_) return Arrival::kDeliver;  // its own messages, looped back
+  Stream& st = streams_[s];
+  if (st.next == 0) {
+    // A reader that is not yet started (no tick seen, or the channel just subscribed) starts
+    // with what it gets; one that is started missed nothing of a new publisher before seq 1.
+    st.next = !ticked_ || fresh_tags_.count(s.tag) ? seq : 1;
+  }
+  if (seq < st.next || st.held.count(seq)) {
+    ++counters_.duplicates;
+    return Arrival::kDuplicate;
+  }
+  if (seq > st.next) {
+    Held& h = st.held[seq];
+    h.channel = channel;
+    h.bytes.assign(bytes, bytes + size);
+    held_bytes_ += size;
+    st.want = std::max(st.want, seq);
+    if (st.gap_since < 0) st.gap_since = now;
+    return Arrival::kHeld;
+  }
+  if (st.last_request >= 0) ++counters_.recovered;
+  ++st.next;
+  release(st);
+  return Arrival::kDeliver;
+}
+
+void Inbox::release(Stream& st) {
+  for (auto it = st.held.begin(); it != st.held.end() && it->first == st.next; it = st.held.erase(it)) {
+    held_bytes_ -= it->second.bytes.size();
+    ready_.push_back({std::move(it->second.channel), std::move(it->second.bytes)});
+    ++st.next;
+  }
+  if (!missing(st)) {
+    st.gap_since = -1;
+    st.last_request = -1;
+  }
+}
+
+bool Inbox::tick(const std::vector<StreamHead>& heads, double now) {
+  for (const StreamHead& h : heads) {
+    if (h.stream.sender == self_ || !tags_.count(h.stream.tag) || h.seq == 0) continue;
+    Stream& st = streams_[h.stream];
+    if (st.next == 0) st.next = !ticked_ || fresh_tags_.count(h.stream.tag) ? h.seq + 1 : 1;
+    if (h.seq >= st.next) {
+      st.want = std::max(st.want, h.seq);
+      if (st.gap_since < 0) st.gap_since = now;
+    }
+  }
+  ticked_ = true;
+  fresh_tags_.clear();
+  return complete();
+}
+
+bool Inbox::complete() const {
+  for (const auto& [key, st] : streams_) {
+    if (missing(st)) return false;
+  }
+  return true;
+}
+
+std::vector<ResendRequest> Inbox::requests(double now) {
+  std::vector<ResendRequest> out;
+  for (auto& [key, st] : streams_) {
+    if (!missing(st)) continue;
+    if (st.last_request >= 0 && now - st.last_request < o_.retry_s) continue;
+    // The first run of missing messages; the next one is asked for once this one is filled.
+    uint32_t last = st.want;
+    if (!st.held.empty()) last = std::min(last, st.held.begin()->first - 1);
+    out.push_back({key, st.next, last});
+    st.last_request = now;
+    ++counters_.requests;
+  }
+  return out;
+}
+
+int64_t Inbox::give_up(double now) {
+  int64_t lost = 0;
+  for (auto& [key, st] : streams_) {
+    if (!missing(st)) continue;
+    const bool too_long = st.gap_since >= 0 && now - st.gap_since >= o_.give_up_s;
+    if (!too_long && held_bytes_ <= o_.max_held_bytes) continue;
+    while (st.next <= st.want) {
+      if (st.held.count(st.next)) {
+        release(st);
+      } else {
+        ++lost;
+        ++st.next;
+      }
+    }
+    release(st);
+  }
+  counters_.lost += lost;
+  return lost;
+}
+
+bool Inbox::ready(Ready* out) {
+  if (ready_.empty()) return false;
+  *out = std::move(ready_.front());
+  ready_.pop_front();
+  return true;
+}
+
+std::vector<uint8_t> ResendHistory::keep(const std::string& channel, uint32_t tag, uint32_t seq,
+                                         std::vector<uint8_t>&& bytes) {
+  Channel& c = channels_[tag];
+  if (c.name.empty()) c.name = channel;
+  c.bytes += bytes.size();
+  total_bytes_ += bytes.size();
+  c.kept.push_back({seq, std::move(bytes)});
+  std::vector<uint8_t> reuse;
+  while (c.kept.size() > 1 && (c.kept.size() > per_channel_ || c.bytes > bytes_per_channel_)) {
+    c.bytes -= c.kept.front().bytes.size();
+    total_bytes_ -= c.kept.front().bytes.size();
+    reuse = std::move(c.kept.front().bytes);
+    c.kept.pop_front();
+  }
+  reuse.clear();
+  return reuse;
+}
+
+const std::vector<uint8_t>* ResendHistory::find(uint32_t tag, uint32_t seq, const std::string** channel) const {
+  const auto it = channels_.find(tag);
+  if (it == channels_.end() || it->second.kept.empty()) return nullptr;
+  const auto& kept = it->second.kept;
+  // Sequence numbers are consecutive in the deque.
+  const uint32_t first = kept.front().seq;
+  if (seq < first || seq - first >= kept.size()) return nullptr;
+  if (channel) *channel = &it->second.name;
+  return &kept[seq - first].bytes;
+}
+
+}  // namespace semx::runtime
