@@ -84,14 +84,24 @@ void MapClient::on_tick(int64_t /*tick*/, int64_t utime) {
   if (apply_ == MapClientOptions::Apply::kOnTick) {
     const bool restarted = last_tick_utime_ >= 0 && utime < last_tick_utime_;
     std::deque<Held> later;
+    std::vector<Held> now;
     for (Held& h : held_) {
       if (restarted || h.utime < utime) {
-        apply(h);
+        now.push_back(std::move(h));
       } else {
         later.push_back(std::move(h));
       }
     }
     held_.swap(later);
+    // In the map's own order, not the order they came in: a snapshot sent again after a loss
+    // (runtime delivery.hpp orders each channel, not snapshots against updates) would otherwise
+    // follow the update after it, and the mirror would see a gap a lossless run does not.
+    std::stable_sort(now.begin(), now.end(), [](const Held& a, const Held& b) {
+      const int64_t sa = a.snapshot ? a.snap.seq : a.delta.seq, sb = b.snapshot ? b.snap.seq : b.delta.seq;
+      // Delta s before the snapshot of map s, as the mapper sends them.
+      return sa < sb || (sa == sb && !a.snapshot && b.snapshot);
+    });
+    for (const Held& h : now) apply(h);
   }
   last_tick_utime_ = utime;
   maybe_request(apply_ == MapClientOptions::Apply::kOnTick ? utime : now());

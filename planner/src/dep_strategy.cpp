@@ -9,6 +9,7 @@
 
 #include "semx/core/angles.hpp"
 #include "semx/core/stopwatch.hpp"
+#include "semx/planner/tour_solver.hpp"
 #include "semx/planner/travel_cost.hpp"
 #include "semx/runtime/semantic_classes.hpp"
 
@@ -604,6 +605,14 @@ PlanOutcome DepStrategy::plan(PlanContext& ctx) {
 
   PlanOutcome out;
   out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep);
+  if (out.goal.valid && in_end_game(ctx)) {
+    int stops = 0;
+    Goal g = tour_goal(ctx, paper_score(), &stops);
+    if (g.valid) {
+      out.goal = std::move(g);
+      out.tour_stops = stops;
+    }
+  }
   ctx.counters->box_checks += checker_.box_checks();
   checker_.reset_counters();
   return out;
@@ -725,6 +734,97 @@ std::vector<double> interpolate_yaws(const std::vector<Eigen::Vector3d>& w, doub
   }
   yaws.back() = core::wrap_angle(goal_yaw);
   return yaws;
+}
+
+}  // namespace semx::planner
+
+namespace semx::planner {
+
+bool DepStrategy::in_end_game(PlanContext& ctx) const {
+  if (config_.loop.end_game_gain <= 0) return false;
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (!n.alive || n.passage || !n.gain.valid || !search_.reached(n.id)) continue;
+    if (n.gain.gain >= config_.loop.end_game_gain) return false;
+  }
+  (void)ctx;
+  return true;
+}
+
+Goal DepStrategy::tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops) {
+  const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
+  // The informative nodes, most informative first (gains refreshed: a stale one is an upper bound).
+  std::vector<std::pair<double, int64_t>> informative;
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (!n.alive || n.passage || !search_.reached(n.id) || n.blacklisted_until >= ctx.cycle) continue;
+    if (!n.gain.valid || n.gain.gain < min_gain) continue;
+    if (n.gain_stale) {
+      evaluate_gain(ctx, n.id);
+      if (graph_.node(n.id).gain.gain < min_gain) continue;
+    }
+    const RoadmapNode& m = graph_.node(n.id);
+    if (nothing_to_do(ctx, n.id, m.gain.yaw)) continue;
+    informative.emplace_back(-m.gain.gain, n.id);
+  }
+  std::sort(informative.begin(), informative.end());
+  // One stop per pocket: a node within the spacing of a stronger stop sees what that one sees.
+  std::vector<int64_t> sites;
+  const double spacing2 = config_.loop.end_game_site_spacing * config_.loop.end_game_site_spacing;
+  for (const auto& [neg_gain, id] : informative) {
+    if (static_cast<int>(sites.size()) >= config_.loop.end_game_max_sites) break;
+    const Eigen::Vector3d& p = graph_.node(id).position;
+    bool near = false;
+    for (int64_t s : sites) near = near || (graph_.node(s).position - p).squaredNorm() < spacing2;
+    if (!near) sites.push_back(id);
+  }
+  Goal goal;
+  *stops = static_cast<int>(sites.size());
+  if (sites.empty()) return goal;
+  int64_t first = sites.front();
+  if (sites.size() > 1) {
+    // The open tour from the vehicle (node 0) through the stops: path length on the roadmap over
+    // v and the turn from one stop's yaw to the next (travel_time).
+    const int n = static_cast<int>(sites.size()) + 1;
+    TourProblem p;
+    p.n = n;
+    p.cost.assign(static_cast<size_t>(n) * static_cast<size_t>(n), 0.0);
+    auto yaw_of = [&](int64_t id) { return graph_.node(id).gain.yaw; };
+    for (int j = 1; j < n; ++j) {
+      const int64_t b = sites[static_cast<size_t>(j - 1)];
+      p.cost[static_cast<size_t>(j)] =
+          travel_time(search_.distance[static_cast<size_t>(b)], ctx.pose.yaw, yaw_of(b), config_.cost);
+    }
+    core::Stopwatch w;
+    for (int i = 1; i < n; ++i) {
+      const int64_t a = sites[static_cast<size_t>(i - 1)];
+      const Roadmap::Search from = graph_.shortest_paths(a);
+      ctx.counters->search_settled += from.settled;
+      for (int j = 1; j < n; ++j) {
+        if (i == j) continue;
+        const int64_t b = sites[static_cast<size_t>(j - 1)];
+        const double d = from.reached(b) ? from.distance[static_cast<size_t>(b)] : 1e6;
+        p.cost[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)] =
+            travel_time(d, yaw_of(a), yaw_of(b), config_.cost);
+      }
+    }
+    ctx.counters->search_ms += w.ms();
+    const Tour t = solve_open_tour(p, 10);
+    first = sites[static_cast<size_t>(t.order.front() - 1)];
+  }
+  const size_t i = static_cast<size_t>(first);
+  const RoadmapNode& n = graph_.node(first);
+  const View v = view_of(ctx, score, first, false);
+  goal.valid = true;
+  goal.node = first;
+  goal.position = n.position;
+  goal.yaw = v.yaw;
+  goal.gain = v.gain;
+  goal.reward = v.reward;
+  goal.cost = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
+  goal.score = v.score;
+  FlownPath f = flown_path(ctx, first);
+  goal.waypoints = std::move(f.waypoints);
+  goal.yaws = std::move(f.yaws);
+  return goal;
 }
 
 }  // namespace semx::planner

@@ -331,7 +331,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     if (!current) {
       need = true;
       why = "goal no longer informative";
-    } else if (o.goal.valid && o.goal.node != goal_.node &&
+    } else if (o.tour_stops == 0 && o.goal.valid && o.goal.node != goal_.node &&
                o.goal.score > config_.loop.hysteresis * *current) {
       need = true;
       std::ostringstream s;
@@ -358,6 +358,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     s << why << ": goal (" << o.goal.position.x() << ", " << o.goal.position.y() << ", "
       << o.goal.position.z() << ") gain " << o.goal.gain << " reward " << o.goal.reward << " score "
       << o.goal.score;
+    if (o.tour_stops > 0) s << " (end game: first of a tour of " << o.tour_stops << " stops)";
     reason = s.str();
   } else if (need) {
     if (why == "path blocked") {

@@ -426,7 +426,8 @@ std::string OracleSummary::describe() const {
   }
   s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
     << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
-    << first_pass << " in the first pass) see " << 100.0 * cover_share() << " % of that (" << cover_dropped
+    << first_pass << " in the first pass, e " << first_pass_exponent << (first_pass_toured ? " toured" : " walked")
+    << ", modelled " << first_pass_target_time << " s to the target share) see " << 100.0 * cover_share() << " % of that (" << cover_dropped
     << " redundant dropped); tour "
     << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
     << "; prepared in " << prepare_ms / 1000.0 << " s";
@@ -581,29 +582,152 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   }
   auto yaw_of = [&](int b) { return b * 2.0 * M_PI / bins; };
 
-  // 3. The first pass: from the vehicle, the view (candidate, yaw) that shows the most T voxels
-  // not yet shown per (second of travel)^time_exponent (travel_time() of the path length on the
-  // true free space and the turn), again and again, until oracle.first_pass of the observable part is shown. What
-  // a view shows only shrinks as more is shown, so a ratio computed earlier is an upper bound:
-  // only the views whose bound comes first are counted again (from the cache).
-  std::vector<uint8_t> shown(m.targets.size(), 0);
-  std::vector<std::pair<int, int>> walk;  // (candidate, bin)
-  {
-    int64_t have = 0;
-    const auto want = static_cast<int64_t>(std::ceil(oc.first_pass * static_cast<double>(observable)));
-    int64_t cur = s;
-    double cur_yaw = start_yaw;
+  // Path lengths (m) on the true free space between cells: row i from cells[i] to every cell
+  // (one search per distinct cell; a place picked at several yaws is one).
+  auto lengths = [&](const std::vector<int64_t>& cells) {
+    const size_t k = cells.size();
+    std::vector<std::vector<double>> length(k, std::vector<double>(k, 0.0));
+    std::vector<int64_t> wanted(cells.begin(), cells.end());
     std::vector<float> len;
+    for (size_t i = 0; i < k; ++i) {
+      bool same = false;
+      for (size_t j = 0; j < i && !same; ++j) {
+        if (cells[j] == cells[i]) {
+          length[i] = length[j];
+          same = true;
+        }
+      }
+      if (same) continue;
+      m.search(cells[i], -1, len, nullptr, &wanted);
+      for (size_t j = 0; j < k; ++j) length[i][j] = len[static_cast<size_t>(cells[j])];
+    }
+    return length;
+  };
+
+  // 3. The first pass: from the vehicle, the view (candidate, yaw) that shows the most T voxels
+  // not yet shown per (second of travel)^e (travel_time() of the path length on the true free
+  // space and the turn), again and again, until oracle.first_pass of the observable part and
+  // oracle.target_share of T are shown. What a view shows only shrinks as more is shown, so a
+  // ratio computed earlier is an upper bound: only the views whose bound comes first are counted
+  // again (from the cache). Which e, and whether the walk's views are flown in the order walked or
+  // in the order of the shortest tour through them, is chosen by the model: the schedule whose
+  // views show target_share of T soonest (each view's voxels counted when the vehicle arrives
+  // there; what it sees on the way is not modelled).
+  const std::vector<int64_t> bound0 = bound;
+  struct Schedule {
+    std::vector<std::pair<int, int>> views;  // (candidate, bin) in the order flown
+    std::vector<double> arrival;             // s, modelled arrival at each
+    std::vector<double> leg_length;          // m, of the leg to each
+    std::vector<uint8_t> shown;              // T ids the views show
+    std::vector<std::vector<int64_t>> legs;  // cells of the path to each view (from the one before)
+    double target_time = std::numeric_limits<double>::infinity();  // when target_share is shown
+    double exponent = 0.0;
+    bool toured = false;
+  };
+  const auto want = static_cast<int64_t>(std::ceil(
+      std::min(static_cast<double>(observable),
+               std::max(oc.first_pass * static_cast<double>(observable),
+                        oc.target_share * static_cast<double>(m.targets.size())))));
+  const auto target = static_cast<int64_t>(std::ceil(oc.target_share * static_cast<double>(m.targets.size())));
+  // The candidate nearest a cell (within the lattice's pitch), -1 when none: what the camera sees
+  // on the way is modelled by what the candidates it passes see.
+  std::unordered_map<int64_t, std::vector<int>> lattice;
+  const double pitch = std::max(oc.spacing, oc.height_step);
+  auto coarse = [&](const Eigen::Vector3d& p) {
+    const int64_t x = static_cast<int64_t>(std::floor(p.x() / pitch)), y = static_cast<int64_t>(std::floor(p.y() / pitch)),
+                  z = static_cast<int64_t>(std::floor(p.z() / pitch));
+    return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+  };
+  for (size_t g = 0; g < groups; ++g) lattice[coarse(m.centre(m.candidates[g]))].push_back(static_cast<int>(g));
+  auto nearest_candidate = [&](int64_t cell) {
+    const Eigen::Vector3d p = m.centre(cell);
+    int best_g = -1;
+    double best_d = pitch * pitch;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = lattice.find(coarse(p + pitch * Eigen::Vector3d(dx, dy, dz)));
+          if (it == lattice.end()) continue;
+          for (int g : it->second) {
+            const double d = (m.centre(m.candidates[static_cast<size_t>(g)]) - p).squaredNorm();
+            if (d < best_d || (d == best_d && g < best_g)) best_d = d, best_g = g;
+          }
+        }
+    return best_g;
+  };
+  auto bin_of = [&](double yaw) {
+    const int b = static_cast<int>(std::lround(core::wrap_angle(yaw) / (2.0 * M_PI / bins)));
+    return ((b % bins) + bins) % bins;
+  };
+  // The modelled time at which a schedule shows `target` voxels of T: each view's voxels on
+  // arrival, and on the way to it what the candidates along the leg see (one every 0.5 m of the
+  // path, at the yaw turning linearly in arc length from the last view's to this one's).
+  auto time_to_target = [&](Schedule& sc) {
+    std::vector<uint8_t> seen(m.targets.size(), 0);
+    int64_t have = 0;
+    sc.target_time = std::numeric_limits<double>::infinity();
+    auto show = [&](int g, int b) {
+      source.elements(g, els);
+      for (const MaskedElement& e : els)
+        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++have;
+      return have >= target;
+    };
+    double yaw0 = start_yaw, t0 = 0.0;
+    for (size_t q = 0; q < sc.views.size(); ++q) {
+      const double yaw1 = yaw_of(sc.views[q].second), t1 = sc.arrival[q];
+      if (q < sc.legs.size() && sc.legs[q].size() > 2) {
+        const std::vector<int64_t>& cells = sc.legs[q];
+        std::vector<double> arc{0.0};
+        for (size_t i = 1; i < cells.size(); ++i) arc.push_back(arc.back() + (m.centre(cells[i]) - m.centre(cells[i - 1])).norm());
+        const double total = arc.back();
+        const double turn = core::wrap_angle(yaw1 - yaw0);
+        double next = 0.5;
+        for (size_t i = 1; i + 1 < cells.size() && total > 0; ++i) {
+          if (arc[i] < next) continue;
+          next = arc[i] + 0.5;
+          const double f = arc[i] / total;
+          const int g = nearest_candidate(cells[i]);
+          if (g >= 0 && show(g, bin_of(yaw0 + f * turn))) {
+            sc.target_time = t0 + f * (t1 - t0);
+            return;
+          }
+        }
+      }
+      if (show(sc.views[q].first, sc.views[q].second)) {
+        sc.target_time = t1;
+        return;
+      }
+      yaw0 = yaw1;
+      t0 = t1;
+    }
+  };
+  // The cells of the path from `from` to `to` (both included), by the parents of a search.
+  auto cell_path = [&](int64_t from, int64_t to, const std::vector<int32_t>& parent) {
+    std::vector<int64_t> cells;
+    for (int64_t i = to; i >= 0 && i != from; i = parent[static_cast<size_t>(i)]) cells.push_back(i);
+    cells.push_back(from);
+    std::reverse(cells.begin(), cells.end());
+    return cells;
+  };
+  auto walk_with = [&](double exponent) {
+    Schedule sc;
+    sc.exponent = exponent;
+    sc.shown.assign(m.targets.size(), 0);
+    bound = bound0;
+    int64_t have = 0;
+    int64_t cur = s;
+    double cur_yaw = start_yaw, clock = 0.0;
+    std::vector<float> len;
+    std::vector<int32_t> parent;
     std::vector<int64_t> gains(static_cast<size_t>(bins));
     std::vector<int> counted(groups, -1);  // the step at which a candidate was last counted
     for (int step = 0; have < want; ++step) {
-      m.search(cur, -1, len, nullptr);
-      // The ratio's denominator: the travel time to the power oracle.time_exponent (< 1 favours
-      // the larger views farther away, which the camera also sees much on the way to).
+      m.search(cur, -1, len, &parent);
+      // The ratio's denominator: the travel time to the power e (< 1 favours the larger views
+      // farther away, which the camera also sees much on the way to).
       auto time_to = [&](size_t g, int b) {
         const float l = len[static_cast<size_t>(m.candidates[g])];
-        return l < kUnreached ? std::pow(travel_time(l, cur_yaw, yaw_of(b), config_.cost), oc.time_exponent)
-                              : -1.0;
+        return l < kUnreached ? std::pow(travel_time(l, cur_yaw, yaw_of(b), config_.cost), exponent) : -1.0;
       };
       using Entry = std::tuple<double, int, int, bool>;  // ratio (bound), candidate, bin, exact
       std::priority_queue<Entry> heap;
@@ -617,6 +741,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       while (!heap.empty()) {
         const auto [ratio, g, b, exact] = heap.top();
         heap.pop();
+        (void)ratio;
         if (exact) {
           pick_g = g;
           pick_b = b;
@@ -627,28 +752,91 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
         source.elements(g, els);
         std::fill(gains.begin(), gains.end(), 0);
         for (const MaskedElement& e : els)
-          if (!shown[static_cast<size_t>(e.element)])
+          if (!sc.shown[static_cast<size_t>(e.element)])
             for (uint32_t x = e.members; x; x &= x - 1) ++gains[static_cast<size_t>(__builtin_ctz(x))];
         for (int k = 0; k < bins; ++k) {
           bound[static_cast<size_t>(g) * static_cast<size_t>(bins) + static_cast<size_t>(k)] = gains[static_cast<size_t>(k)];
           const double t = gains[static_cast<size_t>(k)] > 0 ? time_to(static_cast<size_t>(g), k) : -1.0;
           if (t > 0) heap.emplace(static_cast<double>(gains[static_cast<size_t>(k)]) / t, g, k, true);
         }
-        (void)ratio;
       }
       if (pick_g < 0) break;
       source.elements(pick_g, els);
       for (const MaskedElement& e : els)
-        if ((e.members >> pick_b & 1u) && !shown[static_cast<size_t>(e.element)])
-          shown[static_cast<size_t>(e.element)] = 1, ++have;
-      walk.emplace_back(pick_g, pick_b);
-      summary_.tour_length += len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
-      summary_.tour_time += travel_time(len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])], cur_yaw,
-                                        yaw_of(pick_b), config_.cost);
+        if ((e.members >> pick_b & 1u) && !sc.shown[static_cast<size_t>(e.element)])
+          sc.shown[static_cast<size_t>(e.element)] = 1, ++have;
+      const double l = len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
+      clock += travel_time(l, cur_yaw, yaw_of(pick_b), config_.cost);
+      sc.views.emplace_back(pick_g, pick_b);
+      sc.arrival.push_back(clock);
+      sc.leg_length.push_back(l);
+      sc.legs.push_back(cell_path(cur, m.candidates[static_cast<size_t>(pick_g)], parent));
       cur = m.candidates[static_cast<size_t>(pick_g)];
       cur_yaw = yaw_of(pick_b);
     }
+    time_to_target(sc);
+    return sc;
+  };
+  // The same views in the order of the shortest open tour from the start.
+  auto toured = [&](const Schedule& w) {
+    Schedule sc = w;
+    sc.toured = true;
+    const size_t k = w.views.size();
+    std::vector<int64_t> cells{s};
+    std::vector<double> yaws{start_yaw};
+    for (const auto& [g, b] : w.views) {
+      cells.push_back(m.candidates[static_cast<size_t>(g)]);
+      yaws.push_back(yaw_of(b));
+    }
+    const std::vector<std::vector<double>> length = lengths(cells);
+    std::vector<std::vector<double>> cost(k + 1, std::vector<double>(k + 1, 0.0));
+    for (size_t i = 0; i <= k; ++i)
+      for (size_t j = 1; j <= k; ++j) {
+        const double l = std::isfinite(length[i][j]) ? length[i][j] : 1e6;
+        cost[i][j] = i == j ? 0.0 : travel_time(l, yaws[i], yaws[j], config_.cost);
+      }
+    const Tour t = solve_tour(cost, oc.exact_tour_max);
+    sc.views.clear();
+    sc.arrival.clear();
+    sc.leg_length.clear();
+    sc.legs.clear();
+    double clock = 0.0;
+    std::vector<float> len;
+    std::vector<int32_t> parent;
+    for (size_t q = 1; q < t.order.size(); ++q) {
+      const size_t a = static_cast<size_t>(t.order[q - 1]), b = static_cast<size_t>(t.order[q]);
+      clock += cost[a][b];
+      if (cells[a] != cells[b]) {
+        m.search(cells[a], cells[b], len, &parent);
+        sc.legs.push_back(parent[static_cast<size_t>(cells[b])] >= 0 ? cell_path(cells[a], cells[b], parent)
+                                                                      : std::vector<int64_t>{});
+      } else {
+        sc.legs.emplace_back();
+      }
+      sc.views.push_back(w.views[b - 1]);
+      sc.arrival.push_back(clock);
+      sc.leg_length.push_back(length[a][b]);
+    }
+    time_to_target(sc);
+    return sc;
+  };
+  Schedule best;
+  if (want > 0) {
+    for (double e : {0.5, 1.0}) {
+      Schedule w = walk_with(e);
+      Schedule t = toured(w);
+      for (Schedule* sc : {&w, &t})
+        if (best.views.empty() || sc->target_time < best.target_time - 1e-9) best = std::move(*sc);
+    }
   }
+  std::vector<std::pair<int, int>>& walk = best.views;
+  std::vector<uint8_t> shown = best.shown;
+  if (shown.empty()) shown.assign(m.targets.size(), 0);
+  for (size_t q = 0; q < walk.size(); ++q) summary_.tour_length += best.leg_length[q];
+  if (!walk.empty()) summary_.tour_time += best.arrival.back();
+  summary_.first_pass_exponent = best.exponent;
+  summary_.first_pass_toured = best.toured;
+  summary_.first_pass_target_time = best.target_time;
 
   // 4. The cover of the rest: greedy picks until cover_fraction of the observable part is shown,
   // what the first pass showed counting.
@@ -670,23 +858,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     cell[i + 1] = m.candidates[static_cast<size_t>(cover.picks[i].group)];
     yaw[i + 1] = yaw_of(cover.picks[i].member);
   }
-  std::vector<std::vector<double>> length(k + 1, std::vector<double>(k + 1, 0.0));
-  {
-    std::vector<int64_t> wanted(cell.begin() + 1, cell.end());
-    std::vector<float> len;
-    for (size_t i = 0; i <= k; ++i) {
-      bool same = false;
-      for (size_t j = 0; j < i && !same; ++j) {
-        if (cell[j] == cell[i]) {
-          length[i] = length[j];
-          same = true;
-        }
-      }
-      if (same) continue;
-      m.search(cell[i], -1, len, nullptr, &wanted);
-      for (size_t j = 1; j <= k; ++j) length[i][j] = len[static_cast<size_t>(cell[j])];
-    }
-  }
+  const std::vector<std::vector<double>> length = lengths(cell);
   std::vector<std::vector<double>> cost(k + 1, std::vector<double>(k + 1, 0.0));
   for (size_t i = 0; i <= k; ++i)
     for (size_t j = 1; j <= k; ++j) {

@@ -136,6 +136,9 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("visited_cycles", c.loop.visited_cycles, 0, 1000000);
   l.get("max_start_offset", c.loop.max_start_offset, 0.0, 100.0);
   l.get("yield_goals", c.loop.yield_goals, 0, 1000);
+  l.get("end_game_gain", c.loop.end_game_gain, 0.0, 1e9);
+  l.get("end_game_site_spacing", c.loop.end_game_site_spacing, 0.0, 100.0);
+  l.get("end_game_max_sites", c.loop.end_game_max_sites, 1, 1000);
 
   auto ch = m.child("charge");
   ch.get("base_s", c.charge.base_s, 0.0, 1e3);
@@ -198,7 +201,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("clearance_penalty", c.oracle.clearance_penalty, 0.0, 1e6);
   o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
   o.get("first_pass", c.oracle.first_pass, 0.0, 1.0);
-  o.get("time_exponent", c.oracle.time_exponent, 0.0, 4.0);
+  o.get("target_share", c.oracle.target_share, 0.0, 1.0);
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
   o.get("chain", c.oracle.chain, 1, 1000);
   o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);

@@ -30,7 +30,7 @@ bool ClockServer::finished() const {
   return config_.max_ticks >= 0 && tick_ + 1 >= config_.max_ticks && tick_complete();
 }
 
-std::optional<ClockTick> ClockServer::poll(double wall_s) {
+std::optional<ClockTick> ClockServer::poll(double wall_s, bool inputs_held) {
   if (start_wall_ < 0) start_wall_ = wall_s;
   if (finished()) return std::nullopt;
   bool due = false;
@@ -39,7 +39,7 @@ std::optional<ClockTick> ClockServer::poll(double wall_s) {
   } else if (config_.mode == ClockMode::kRealtime) {
     due = wall_s >= start_wall_ + static_cast<double>(tick_ + 1) * config_.period_us * 1e-6 / config_.speed;
   } else {
-    due = tick_complete() && (config_.max_speed <= 0 ||
+    due = tick_complete() && inputs_held && (config_.max_speed <= 0 ||
                               wall_s >= start_wall_ + static_cast<double>(tick_ + 1) * config_.period_us *
                                                           1e-6 / config_.max_speed);
   }

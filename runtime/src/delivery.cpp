@@ -13,9 +13,9 @@ Inbox::Arrival Inbox::arrive(const StreamKey& s, uint32_t seq, const std::string
   if (s.sender == self_) return Arrival::kDeliver;  // its own messages, looped back
   Stream& st = streams_[s];
   if (st.next == 0) {
-    // A reader that is not yet started (no tick seen, or the channel just subscribed) starts
-    // with what it gets; one that is started missed nothing of a new publisher before seq 1.
-    st.next = !ticked_ || fresh_tags_.count(s.tag) ? seq : 1;
+    // A late reader not yet started (no tick seen, or the channel just subscribed) starts with
+    // what it gets; otherwise nothing of a publisher before seq 1 was missed.
+    st.next = !o_.from_start && (!ticked_ || fresh_tags_.count(s.tag)) ? seq : 1;
   }
   if (seq < st.next || st.held.count(seq)) {
     ++counters_.duplicates;
@@ -52,7 +52,10 @@ bool Inbox::tick(const std::vector<StreamHead>& heads, double now) {
   for (const StreamHead& h : heads) {
     if (h.stream.sender == self_ || !tags_.count(h.stream.tag) || h.seq == 0) continue;
     Stream& st = streams_[h.stream];
-    if (st.next == 0) st.next = !ticked_ || fresh_tags_.count(h.stream.tag) ? h.seq + 1 : 1;
+    if (st.next == 0) {
+      const bool fresh = fresh_tags_.count(h.stream.tag) || (!ticked_ && !o_.from_start);
+      st.next = fresh ? h.seq + 1 : 1;
+    }
     if (h.seq >= st.next) {
       st.want = std::max(st.want, h.seq);
       if (st.gap_since < 0) st.gap_since = now;
@@ -74,19 +77,36 @@ std::vector<ResendRequest> Inbox::requests(double now) {
   std::vector<ResendRequest> out;
   for (auto& [key, st] : streams_) {
     if (!missing(st)) continue;
-    if (st.last_request >= 0 && now - st.last_request < o_.retry_s) continue;
-    // The first run of missing messages; the next one is asked for once this one is filled.
-    uint32_t last = st.want;
-    if (!st.held.empty()) last = std::min(last, st.held.begin()->first - 1);
-    out.push_back({key, st.next, last});
-    st.last_request = now;
-    ++counters_.requests;
+    // Runs not asked for yet go out at once; runs asked for already, again every retry_s (the
+    // answer may be on its way). Every run of the stream, or a busy stream falls further behind
+    // than its publisher keeps.
+    const bool retry = st.last_request < 0 || now - st.last_request >= o_.retry_s;
+    bool any = false;
+    uint32_t seq = st.next;
+    auto held = st.held.begin();
+    for (int runs = 0; seq <= st.want && runs < 32; ++runs) {
+      while (held != st.held.end() && held->first < seq) ++held;
+      while (held != st.held.end() && held->first == seq) {
+        ++seq;
+        ++held;
+      }
+      if (seq > st.want) break;
+      const uint32_t last = held == st.held.end() ? st.want : std::min(st.want, held->first - 1);
+      if (retry || last > st.asked) {
+        out.push_back({key, retry ? seq : std::max(seq, st.asked + 1), last});
+        ++counters_.requests;
+        any = true;
+      }
+      seq = last + 1;
+    }
+    if (any && retry) st.last_request = now;
+    st.asked = std::max(st.asked, st.want);
   }
   return out;
 }
 
-int64_t Inbox::give_up(double now) {
-  int64_t lost = 0;
+std::vector<ResendRequest> Inbox::give_up(double now) {
+  std::vector<ResendRequest> lost;
   for (auto& [key, st] : streams_) {
     if (!missing(st)) continue;
     const bool too_long = st.gap_since >= 0 && now - st.gap_since >= o_.give_up_s;
@@ -94,14 +114,19 @@ int64_t Inbox::give_up(double now) {
     while (st.next <= st.want) {
       if (st.held.count(st.next)) {
         release(st);
-      } else {
-        ++lost;
-        ++st.next;
+        continue;
       }
+      if (lost.empty() || lost.back().stream.sender != key.sender || lost.back().stream.tag != key.tag ||
+          lost.back().last + 1 != st.next) {
+        lost.push_back({key, st.next, st.next});
+      } else {
+        lost.back().last = st.next;
+      }
+      ++counters_.lost;
+      ++st.next;
     }
     release(st);
   }
-  counters_.lost += lost;
   return lost;
 }
 
@@ -134,9 +159,9 @@ const std::vector<uint8_t>* ResendHistory::find(uint32_t tag, uint32_t seq, cons
   const auto it = channels_.find(tag);
   if (it == channels_.end() || it->second.kept.empty()) return nullptr;
   const auto& kept = it->second.kept;
-  // Sequence numbers are consecutive in the deque.
+  // Sequence numbers are consecutive in the deque (every message of the channel is kept).
   const uint32_t first = kept.front().seq;
-  if (seq < first || seq - first >= kept.size()) return nullptr;
+  if (seq < first || seq - first >= kept.size() || kept[seq - first].seq != seq) return nullptr;
   if (channel) *channel = &it->second.name;
   return &kept[seq - first].bytes;
 }

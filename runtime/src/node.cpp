@@ -66,13 +66,9 @@ bool tracked(const std::string& channel) {
          channel != channels::SIM_RESEND;
 }
 
-Inbox::Options inbox_options(const NodeOptions& o) {
-  Inbox::Options io;
-  // In lockstep a gap costs only wall time, so it is waited for long; in realtime a message
-  // that comes much later is old news.
-  io.give_up_s = o.lockstep ? 3.0 : 0.3;
-  return io;
-}
+// In lockstep a gap costs only wall time, so it is waited for long (and a recorder wants every
+// message); in realtime a message that comes much later is old news.
+constexpr double kGiveUpLockstepS = 10.0, kGiveUpRealtimeS = 0.3;
 
 AuthKey node_key(const NodeOptions& o) {
   try {
@@ -120,7 +116,7 @@ Node::Node(NodeOptions options)
       key_(node_key(options_)),
       signer_(key_),
       verifier_(key_),
-      inbox_(signer_.sender(), inbox_options(options_)),
+      inbox_(signer_.sender(), Inbox::Options{0.05, kGiveUpLockstepS, 64u << 20}),
       clock_(options_.lockstep) {
   if (options_.name.empty()) throw NodeError("a node needs a name");
   options_.lcm_url = resolve_lcm_url(options_.lcm_url);
@@ -148,6 +144,10 @@ Node::Node(NodeOptions options)
   subscribe<semx::resend_t>(
       channels::SIM_RESEND, [this](const semx::resend_t& r) { on_resend_request(r); },
       [](const semx::resend_t& r) { return r.first_seq >= 1 && r.last_seq >= r.first_seq; });
+  // A node started into a running set (respawned: SEMX_RESTART > 0, or an observer) owes
+  // nothing to what was sent before it came.
+  const char* restart = std::getenv("SEMX_RESTART");
+  inbox_.set_from_start(!options_.observer && !(restart && std::atoi(restart) > 0));
   next_status_ = std::chrono::steady_clock::now();
 }
 
@@ -332,7 +332,14 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
       AckHeads& h = ack_heads_[a.node];
       h.sender = a.sender;
       h.heads.clear();
-      for (int i = 0; i < a.num_heads; ++i) h.heads.emplace_back(a.head_tag[i], a.head_seq[i]);
+      std::vector<StreamHead> named;
+      for (int i = 0; i < a.num_heads; ++i) {
+        h.heads.emplace_back(a.head_tag[i], a.head_seq[i]);
+        named.push_back({{static_cast<uint64_t>(a.sender), static_cast<uint32_t>(a.head_tag[i])},
+                         static_cast<uint32_t>(a.head_seq[i])});
+      }
+      // What the clock itself reads (the controller's commands) must be held before the next tick.
+      inbox_.tick(named, wall_s());
     });
   }
   semx::clock_t m = msg;
@@ -362,6 +369,8 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
 
 void Node::service_delivery() {
   const double now = wall_s();
+  inbox_.set_give_up_s(clock_.started() && clock_.mode() == ClockMode::kRealtime ? kGiveUpRealtimeS
+                                                                                 : kGiveUpLockstepS);
   for (const ResendRequest& q : inbox_.requests(now)) {
     semx::resend_t r;
     r.utime = clock_.now_utime();
@@ -372,12 +381,17 @@ void Node::service_delivery() {
     r.last_seq = static_cast<int32_t>(q.last);
     publish(channels::SIM_RESEND, r);
   }
-  if (const int64_t lost = inbox_.give_up(now); lost > 0) {
-    counters_.lost += lost;
-    std::cerr << options_.name << ": gave up on " << lost << " lost message" << (lost == 1 ? "" : "s") << " ("
-              << counters_.lost << " so far): this run is not the one a lossless bus gives\n";
-    deliver_ready();
+  const auto lost = inbox_.give_up(now);
+  for (const ResendRequest& l : lost) {
+    counters_.lost += l.last - l.first + 1;
+    std::string channel = "tag " + std::to_string(l.stream.tag);
+    for (const auto& [name, subs] : subs_)
+      if (channel_tag(name) == l.stream.tag) channel = name;
+    std::cerr << options_.name << ": gave up on " << channel << " messages " << l.first << ".." << l.last
+              << " of sender " << std::hex << l.stream.sender << std::dec << " (" << counters_.lost
+              << " lost so far): this run is not the one a lossless bus gives\n";
   }
+  if (!lost.empty()) deliver_ready();
   counters_.recovered = inbox_.counters().recovered;
   while (!held_ticks_.empty() && inbox_.complete()) {
     const semx::clock_t tick = std::move(held_ticks_.front());
@@ -498,6 +512,9 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
   if (!sent) {
     ++c.dropped;
     ++counters_.dropped;
+    // Kept all the same: its sequence number is spent, and a reader will ask for it.
+    if (options_.sign && tracked(channel))
+      bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
     return false;
   }
   ++c.messages;
@@ -594,6 +611,7 @@ semx::node_status_t Node::status() const {
   s.foreign = counters_.foreign;
   s.refused = counters_.refused;
   s.lost = counters_.lost;
+  s.observer = options_.observer;
   s.recovered = counters_.recovered;
   s.cpu_s = cpu_seconds();
   s.rss_kb = rss_kb();

@@ -171,7 +171,9 @@ bool SimulatorNode::poll(double wall_s) {
   if (!ready_ && !check_ready(wall_s)) return true;
   if (wall_start_ < 0) wall_start_ = wall_s;
   if (server_.finished()) return false;
-  if (auto t = server_.poll(wall_s)) {
+  // A command an ack named but that was lost on the way is asked for again before the next
+  // tick: the vehicle must fly the run a lossless bus gives.
+  if (auto t = server_.poll(wall_s, node_.holds_everything())) {
     if (!t->resend) {
       advance_to(t->utime);
       // Saved before the tick goes out: a simulator killed after this resends this tick, one

@@ -119,6 +119,25 @@ TEST(RunFolder, WritesTheFilesAndCoverageCsvReadsBack) {
   EXPECT_THROW(read_coverage_csv(dir + "/missing.csv"), RunFolderError);
 }
 
+TEST(RunFolder, CoverageCsvMarksTheRowsFromTime95AndTheEndGame) {
+  RunSummary s = example(true);  // samples at 0, 10, ..., 50 s
+  s.time_95_s = 20.0;
+  s.time_settled_s = 35.5;
+  std::istringstream in(coverage_csv(s));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct,reached_95,end_game");
+  std::vector<std::string> flags;
+  while (std::getline(in, line)) flags.push_back(line.substr(line.size() - 3));
+  EXPECT_EQ(flags, (std::vector<std::string>{"0,0", "0,0", "1,0", "1,0", "1,1", "1,1"}));
+  // Never reached, never settled (no map update): no row marked.
+  s.time_95_s.reset();
+  s.time_settled_s.reset();
+  const std::string none = coverage_csv(s);
+  EXPECT_EQ(none.find(",1\n"), std::string::npos) << none;
+  EXPECT_EQ(none.find(",1,"), std::string::npos) << none;
+}
+
 TEST(RunFolder, AFolderThatCannotBeCreatedIsAnErrorNamingIt) {
   const std::string base = test::temp_dir("blocked");
   fs::create_directories(base);

@@ -218,7 +218,7 @@ SyntheticWorld tiny_world() {
 
 PlannerConfig tiny_config() {
   PlannerConfig c = test_config("oracle");
-  c.oracle.spacing = 1.6;  // 4 candidates at 4 yaws: a brute force of seconds
+  c.oracle.spacing = 1.2;  // 9 candidates at 4 yaws: a brute force of a second
   c.oracle.height_step = 1.0;  // one level of candidates
   c.sampling.z_min = 1.0;
   c.sampling.z_max = 1.4;
@@ -226,18 +226,17 @@ PlannerConfig tiny_config() {
   c.oracle.rays_azimuth = 128;
   c.oracle.rays_elevation = 24;
   c.oracle.first_pass = 0.0;  // the cover and one tour, as brute force checks them
+  c.oracle.target_share = 0.0;
   return c;
 }
 
-// DISABLED: with the room and lattice of this session's last oracle change the case ran for more
-// than 13 minutes (ctest's limit is 10) on a loaded machine; it must be made small again (fewer
-// candidates or yaws for the brute force) before it is enabled. Run it with
-// --gtest_also_run_disabled_tests.
-TEST(Oracle, DISABLED_OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
+// A share below 1: a full cover of this room needs every (candidate, yaw) set (each holds a few
+// voxels of floor or wall no other does), and a tour through all of them is beyond brute force.
+TEST(Oracle, OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
   const SyntheticWorld world = tiny_world();
   const SyntheticTruth truth(world);
   PlannerConfig c = tiny_config();
-  c.oracle.cover_fraction = 1.0;
+  c.oracle.cover_fraction = 0.9;
   OracleStrategy oracle(c);
   oracle.set_truth(&truth);
   ASSERT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
@@ -267,19 +266,21 @@ TEST(Oracle, DISABLED_OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
   }
   const OracleSummary& s = oracle.summary();
   EXPECT_EQ(s.observable, static_cast<int64_t>(all.count()));
-  EXPECT_EQ(s.covered, s.observable);  // fraction 1
+  const auto required = static_cast<size_t>(std::ceil(0.9 * static_cast<double>(all.count()) - 1e-9));
+  EXPECT_GE(s.covered, static_cast<int64_t>(required));
   EXPECT_GT(s.observable_share(), 0.9);
-  // No fewer sets cover it all.
-  const int best = brute_force_cover(sets, all.count(), static_cast<int>(oracle.picks().size()));
+  // No fewer sets show the required share, and the picks show what the summary says.
+  const int best = brute_force_cover(sets, required, static_cast<int>(oracle.picks().size()));
   ASSERT_GT(best, 0);
   EXPECT_EQ(static_cast<int>(oracle.picks().size()), best);
   std::bitset<32768> mine;
   for (const CoverPick& p : oracle.picks()) mine |= sets[static_cast<size_t>(p.group * c.gain.yaw_bins + p.member)];
-  EXPECT_EQ(mine.count(), all.count());
+  EXPECT_EQ(static_cast<int64_t>(mine.count()), s.covered);
 
   // The tour: the best order of its viewpoints by brute force, and the viewpoints flown in it.
   const auto& costs = oracle.tour_costs();
   ASSERT_EQ(costs.size(), oracle.picks().size() + 1);
+  ASSERT_LE(costs.size(), 9u) << "a brute force of (picks)! orders";
   EXPECT_NEAR(tour_cost(costs, oracle.tour_order()), brute_force_tour(costs), 1e-9);
   EXPECT_NEAR(s.tour_time, brute_force_tour(costs), 1e-9);
   EXPECT_TRUE(s.tour_exact);

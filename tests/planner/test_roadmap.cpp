@@ -756,3 +756,47 @@ TEST(DepRoadmap, SameSeedSameRoadmap) {
 
 }  // namespace
 }  // namespace semx::planner
+
+namespace semx::planner {
+namespace {
+
+// A known 18 x 4 m corridor with three small unknown pockets on the floor, at x = 0.5, 10 and 17
+// (farther apart than the camera's 5 m); the vehicle at x = 7. Greedy G/T goes to the nearest
+// pocket first (x = 10), on to x = 17 and back past the start for the last (26.5 m in all); the
+// shortest tour through the three starts at the near end (23 m).
+TEST(DepRoadmap, TheEndGameFliesTheShortestTourThroughThePocketsLeft) {
+  auto run = [](double end_game_gain, int* stops) {
+    DepFixture f;
+    const SyntheticWorld w = SyntheticWorld::room({18, 4, 2.5}, {7, 2, 1.2});
+    w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(18.2, 4.2, 2.7)});
+    for (double x : {0.5, 10.0, 17.0}) fill_m(f.grid, {x - 0.45, 1.55, 0.05}, {x + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
+    f.frontiers.reset(f.grid);
+    // Pockets of a few hundred voxels: informative only close by (the test's sparser gain rays
+    // count fewer than the default).
+    f.config.gain.min_gain = 400;
+    f.config.loop.end_game_gain = end_game_gain;
+    DepStrategy dep(f.config, false);
+    dep.on_map_reset();
+    PlanOutcome o;
+    // The roadmap grows over a few cycles; the goal of the last one is compared.
+    for (int64_t cycle = 1; cycle <= 30; ++cycle) {
+      PlanContext ctx = f.context({7.0, 2.0, 1.2}, 0.0, cycle);
+      o = dep.plan(ctx);
+    }
+    *stops = o.tour_stops;
+    return o.goal;
+  };
+  int stops = 0;
+  const Goal greedy = run(0.0, &stops);
+  ASSERT_TRUE(greedy.valid);
+  EXPECT_EQ(stops, 0);
+  EXPECT_GT(greedy.position.x(), 7.5) << "greedy: toward the nearest pocket";
+  // Every gain below the end game's threshold: the tour.
+  const Goal tour = run(1e9, &stops);
+  ASSERT_TRUE(tour.valid);
+  EXPECT_GE(stops, 3) << tour.position.transpose();
+  EXPECT_LT(tour.position.x(), 4.0) << "the tour starts at the near end";
+}
+
+}  // namespace
+}  // namespace semx::planner

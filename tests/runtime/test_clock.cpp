@@ -94,6 +94,7 @@ TEST(ClockServer, ResumesAtItsLastTickAndWaitsForEveryAckAgain) {
   cfg.mode = ClockMode::kLockstep;
   cfg.lockstep_nodes = {"mapper", "planner"};
   cfg.max_ticks = 500;
+  cfg.resend_after_s = 1.0;
   ClockServer s(cfg);
   s.resume(420, 50.0);
   auto t = s.poll(50.0);

@@ -78,8 +78,45 @@ TEST(Delivery, ATickNamesALostLastMessage) {
   EXPECT_TRUE(in.tick({{{kMapper, 99}, 5}, {{kSelf, 42}, 9}}, 1.0));
 }
 
-TEST(Delivery, WhatCameBeforeAReaderStartedIsNotMissing) {
+TEST(Delivery, AReaderThereFromTheStartIsOwedEverything) {
   Inbox in(kSelf);
+  in.reads(42);
+  // The first frame was lost before the first tick: the tick's heads name it.
+  EXPECT_FALSE(in.tick({{kMap, 1}}, 0));
+  ASSERT_EQ(in.requests(0).size(), 1u);
+  EXPECT_EQ(arrive(in, 1), Inbox::Arrival::kDeliver);
+  EXPECT_TRUE(in.complete());
+  // And a stream first heard at its 3rd message misses the first two.
+  const StreamKey other{kMapper + 5, 42};
+  const uint8_t b[1] = {3};
+  EXPECT_EQ(in.arrive(other, 3, "MAP_UPDATE", b, 1, 0), Inbox::Arrival::kHeld);
+}
+
+TEST(Delivery, ManyGapsInOneStreamAreAllAskedForAtOnce) {
+  Inbox in(kSelf);
+  in.reads(42);
+  in.tick({}, 0);
+  arrive(in, 1);
+  for (uint32_t seq : {3u, 5u, 6u, 9u}) arrive(in, seq, 0.0);
+  auto q = in.requests(0.0);
+  ASSERT_EQ(q.size(), 3u);  // 2, 4, 7..8
+  EXPECT_EQ(q[0].first, 2u);
+  EXPECT_EQ(q[1].first, 4u);
+  EXPECT_EQ(q[2].first, 7u);
+  EXPECT_EQ(q[2].last, 8u);
+  // A new gap is asked for at once; the old ones only after retry_s.
+  arrive(in, 12, 0.01);
+  q = in.requests(0.01);
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(q[0].first, 10u);
+  EXPECT_EQ(q[0].last, 11u);
+  EXPECT_EQ(in.requests(0.1).size(), 4u);
+}
+
+TEST(Delivery, WhatCameBeforeALateReaderStartedIsNotMissing) {
+  Inbox::Options late;
+  late.from_start = false;  // a respawned node, an observer
+  Inbox in(kSelf, late);
   in.reads(42);
   // Its first tick: the mapper had sent 10 messages before this reader existed.
   EXPECT_TRUE(in.tick({{kMap, 10}}, 0));
@@ -101,15 +138,20 @@ TEST(Delivery, WhatCameBeforeAReaderStartedIsNotMissing) {
 }
 
 TEST(Delivery, WhatNeverComesIsGivenUpAndCounted) {
-  Inbox in(kSelf, {0.05, 2.0, 64u << 20});
+  Inbox in(kSelf, {0.05, 2.0, 64u << 20, true});
   in.reads(42);
   in.tick({}, 0);
   arrive(in, 1);
   arrive(in, 3, 10.0);
   arrive(in, 6, 10.0);
-  EXPECT_EQ(in.give_up(11.0), 0);  // not yet
+  EXPECT_TRUE(in.give_up(11.0).empty());  // not yet
   EXPECT_FALSE(in.complete());
-  EXPECT_EQ(in.give_up(12.5), 3);  // 2, 4, 5
+  const auto lost = in.give_up(12.5);  // 2, then 4 and 5
+  ASSERT_EQ(lost.size(), 2u);
+  EXPECT_EQ(lost[0].first, 2u);
+  EXPECT_EQ(lost[0].last, 2u);
+  EXPECT_EQ(lost[1].first, 4u);
+  EXPECT_EQ(lost[1].last, 5u);
   EXPECT_EQ(drain(in), (std::vector<int>{3, 6}));
   EXPECT_TRUE(in.complete());
   EXPECT_EQ(in.counters().lost, 3);

@@ -344,6 +344,7 @@ TEST(SimulatorNode, ResumedLockstepResendsItsLastTickAndWaitsForTheAcks) {
   o.resume = true;
   o.clock.lockstep_nodes = {"mapper"};
   o.clock.max_ticks = 100;
+  o.clock.resend_after_s = 1.0;  // one resend in this test's 0.2 s
   SimulatorConfig cfg;
   Simulator sim(test::shipped("env1"), cfg);
   runtime::Node node(memq_node());

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   return run_main("semx-clock", [&] {
     NodeFlags flags("clock");
     std::string mode = "realtime", nodes;
-    double period_ms = 10, speed = 1, max_speed = 0, resend_s = 0.5, stall_warn_s = 5;
+    double period_ms = 10, speed = 1, max_speed = 0, resend_s = 0.05, stall_warn_s = 5;
     int64_t ticks = -1;
     ArgParser p("semx-clock",
                 "Publishes SIM_CLOCK. LOCKSTEP advances only when every --lockstep-nodes node acked.");
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
         .option("max-speed", "X", "LOCKSTEP: at most X simulated seconds per wall second (default: no cap)",
                 &max_speed)
         .option("ticks", "N", "exit after N ticks (default: run until stopped)", &ticks)
-        .option("resend", "S", "LOCKSTEP: resend an unacked tick after S wall seconds (default 0.5)",
+        .option("resend", "S", "LOCKSTEP: resend an unacked tick after S wall seconds (default 0.05)",
                 &resend_s)
         .option("stall-warn", "S", "LOCKSTEP: report nodes that keep the clock waiting longer (default 5)",
                 &stall_warn_s);
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     bool warned = false;
     while (!node.stopped() && !server.finished()) {
       const double now = wall_seconds();
-      if (auto t = server.poll(now)) {
+      if (auto t = server.poll(now, node.holds_everything())) {
         semx::clock_t c{};
         c.utime = t->utime;
         c.tick = t->tick;

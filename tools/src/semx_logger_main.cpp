@@ -78,6 +78,7 @@ int main(int argc, char** argv) {
     auto options = flags.options();
     options.follow_clock = false;  // a recorder keeps no time of its own
     options.announce = false;
+    options.observer = true;
     Node node(options);
     install_shutdown_handlers();
     int64_t failed = 0;

@@ -45,7 +45,9 @@ int main(int argc, char** argv) {
       if (!n.empty()) expected.push_back(n);
     }
 
-    Node node(flags.options());
+    auto options = flags.options();
+    options.observer = true;
+    Node node(options);
     install_shutdown_handlers();
     semx::tools::StatusBoard board;
     node.subscribe<semx::node_status_t>(semx::channels::NODE_STATUS, [&](const semx::node_status_t& s) {

@@ -125,7 +125,8 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
   // Who of the set restarted, and when (a disturbed run is marked so in metrics.json), and each
   // node's messages lost for good.
   node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& m) {
-    if (m.lost > 0) lost_[m.node] = std::max(lost_[m.node], m.lost);
+    // A recorder's or viewer's losses leave its log or picture short, not the run.
+    if (m.lost > 0 && !m.observer) lost_[m.node] = std::max(lost_[m.node], m.lost);
     const int64_t t = std::max(node_.now_utime(), evaluation_.metrics().now_utime());
     const size_t before = evaluation_.restarts().size();
     evaluation_.on_node_status(m.node, m.pid, m.restarts, t);

@@ -163,10 +163,14 @@ std::string metrics_csv_row(const RunSummary& s) {
 
 std::string coverage_csv(const RunSummary& s) {
   std::ostringstream o;
-  o << "t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct\n";
+  // reached_95: 1 from Time_95 on; end_game: 1 from Time_settled on (the map within 0.5 points of
+  // its final coverage), so the end game is the rows marked 1 up to Time_f.
+  o << "t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct,reached_95,end_game\n";
+  auto from = [](const std::optional<double>& t, double at) { return t && at >= *t - 1e-9 ? 1 : 0; };
   for (const auto& c : s.coverage) {
     o << number(c.t_s) << ',' << number(c.coverage_pct) << ',' << number(c.distance_m) << ',' << c.covered
-      << ',' << number(c.object_coverage_pct) << '\n';
+      << ',' << number(c.object_coverage_pct) << ',' << from(s.time_95_s, c.t_s) << ','
+      << from(s.time_settled_s, c.t_s) << '\n';
   }
   return o.str();
 }

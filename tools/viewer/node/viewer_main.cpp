@@ -103,7 +103,9 @@ int main(int argc, char** argv) {
       o.on_frame = [w](const evaluator::Image& img, int64_t) { w->show(img); };
     }
 
-    runtime::Node node(flags.options());
+    auto node_options = flags.options();
+    node_options.observer = true;  // it draws the run, it does not change it
+    runtime::Node node(node_options);
     runtime::install_shutdown_handlers();
     viewer::ViewerNode v(node, std::move(o));
     std::cout << "semx-viewer: on " << node.url() << (flags.lockstep ? " (lockstep)" : "")

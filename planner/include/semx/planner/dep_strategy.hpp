@@ -126,6 +126,11 @@ class DepStrategy : public Strategy {
   // Some voxel of obstacle_voxels_ has its centre within `radius` of the segment a-b.
   bool obstacle_near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double res) const;
   bool nothing_to_do(PlanContext& ctx, int64_t id, double yaw) const;
+  // The end game (loop.end_game_gain): whether no reachable node's gain (cached: an upper bound)
+  // reaches it after select_goal; and then the first stop of the shortest open tour from the
+  // vehicle through the informative nodes, one per end_game_site_spacing (invalid when none).
+  bool in_end_game(PlanContext& ctx) const;
+  Goal tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops);
 
   PlannerConfig config_;
   bool semantic_;

@@ -64,6 +64,10 @@ struct PlanOutcome {
   // Nothing is left to do at all (the oracle flew its last viewpoint): DONE at once, without the
   // done_cycles of cycles that look for a goal again.
   bool finished = false;
+  // The goal is the first stop of a tour (DEP's end game): the main loop keeps the goal being
+  // flown until it is reached or no longer informative, without switching on score. The tour's
+  // stops, 0 when the goal is no tour's.
+  int tour_stops = 0;
 };
 
 class Strategy {

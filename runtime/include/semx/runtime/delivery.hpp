@@ -50,6 +50,11 @@ class Inbox {
     double retry_s = 0.05;      // wall seconds between requests for the same gap
     double give_up_s = 3.0;     // wall seconds a gap is waited for before its messages count as lost
     std::size_t max_held_bytes = 64u << 20;  // beyond it the oldest gap is given up at once
+    // A reader there from its set's start owes nothing to chance: every publisher's messages are
+    // for it from seq 1 (the few sent before it subscribed are still kept for resending). One
+    // that joins a running set (a respawned node, an observer started later) starts with what
+    // it first gets, or with the heads of its first tick.
+    bool from_start = true;
   };
   explicit Inbox(uint64_t self) : self_(self) {}
   Inbox(uint64_t self, Options o) : self_(self), o_(o) {}
@@ -57,6 +62,7 @@ class Inbox {
   // The channels read; one subscribed after the first tick takes its publishers' current heads
   // as its start (what came before was not for this reader).
   void reads(uint32_t tag);
+  void set_from_start(bool b) { o_.from_start = b; }
 
   enum class Arrival { kDeliver, kDuplicate, kHeld };
   // A message arrived. kDeliver: hand it over now, then take ready() ones. kHeld: it follows a
@@ -71,8 +77,8 @@ class Inbox {
   // The gaps to ask for now (each again every retry_s).
   std::vector<ResendRequest> requests(double now);
   // Gives up the gaps waited for longer than give_up_s (or past the held budget); their held
-  // followers become ready. Returns how many messages were given up.
-  int64_t give_up(double now);
+  // followers become ready. Returns the messages given up, as runs of sequence numbers.
+  std::vector<ResendRequest> give_up(double now);
 
   struct Ready {
     std::string channel;
@@ -82,6 +88,7 @@ class Inbox {
   bool ready(Ready* out);
 
   const InboxCounters& counters() const { return counters_; }
+  void set_give_up_s(double s) { o_.give_up_s = s; }
   std::size_t held_bytes() const { return held_bytes_; }
 
  private:
@@ -95,7 +102,8 @@ class Inbox {
     uint32_t want = 0;   // the last seq known to exist (from a tick or a later message)
     std::map<uint32_t, Held> held;
     double gap_since = -1;
-    double last_request = -1;
+    double last_request = -1;  // the last time missing messages were asked for again
+    uint32_t asked = 0;        // everything up to here was asked for at least once
   };
   bool missing(const Stream& st) const { return st.next != 0 && st.next <= st.want; }
   void release(Stream& st);

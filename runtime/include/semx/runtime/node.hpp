@@ -64,6 +64,9 @@ struct NodeOptions {
   // Off only for tools that play an outsider (semx-hostile --unsigned): messages go out without a
   // trailer, and every semx node drops them.
   bool sign = true;
+  // A process that watches a set and changes nothing of its run (recorder, monitor, viewer): its
+  // lost messages make a log or a picture incomplete, not the run invalid (NODE_STATUS observer).
+  bool observer = false;
   // How often the launcher restarted this process (restart_count.hpp), reported in NODE_STATUS.
   int restarts = restart_count();
 };
@@ -154,6 +157,9 @@ class Node {
   // its promise (a planning cycle whose outputs are charged time) then overlaps other nodes'.
   void after_ack(std::function<void()> fn) { after_ack_.push_back(std::move(fn)); }
   const SimClock& clock() const { return clock_; }
+  // True when no message a tick's or an ack's heads named is missing (delivery.hpp). The clock's
+  // source issues the next lockstep tick only then.
+  bool holds_everything() const { return inbox_.complete(); }
   int64_t now_utime() const { return clock_.now_utime(); }
   // LOCKSTEP: asked after the tick handlers, before each ack: the earliest message time at which
   // this node may publish again, whatever it receives meanwhile (its own schedule: next cycle,

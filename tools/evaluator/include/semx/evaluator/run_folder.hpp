@@ -5,7 +5,7 @@
 //                  time_r_s (null when the threshold was never reached), collisions, wall_s, then
 //                  context (termination, sim_s, resolution_m, target_voxels, ...);
 //   metrics.csv    a header and one row with the same scalar keys (runs concatenate into a table);
-//   coverage.csv   t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct: over time;
+//   coverage.csv   t_s,coverage_pct,distance_m,covered_voxels,object_coverage_pct,reached_95,end_game: over time;
 //   coverage.png   the coverage-over-time plot (coverage_plot.hpp);
 //   map.png        the top-down map with the flown trajectory (map_picture.hpp).
 //
