@@ -41,6 +41,10 @@ bool would_be_due(int64_t now, int64_t next, double period_s) {
   return period_s > 0 && (next < 0 || now >= next);
 }
 
+constexpr uint32_t kJournalKind = runtime::state_kind("MAPJ");
+
+std::string journal_path(const std::string& checkpoint) { return checkpoint + ".journal"; }
+
 template <class T>
 std::vector<uint8_t> encode(const T& m) {
   const int size = m.getEncodedSize();
@@ -94,28 +98,71 @@ void MapperNode::restore_checkpoint() {
     throw runtime::ConfigError("checkpoint " + checkpoint_path_ + ": directory " + dir.string() +
                                " does not exist");
   }
+  int64_t base_seq = 0;
   if (!fs::exists(path, ec)) {
     startup_note_ = "no checkpoint at " + checkpoint_path_ + " yet; one is written every " +
                     std::to_string(mapper_.config().checkpoint.period) + " s of simulation time";
-    return;
+  } else {
+    try {
+      const CheckpointInfo info = mapper_.load_checkpoint(checkpoint_path_);
+      base_seq = info.seq;
+      checkpoint_seq_ = mapper_.seq();
+      startup_note_ = "restored " + checkpoint_path_ + " (seq " + std::to_string(info.seq) + ", " +
+                      std::to_string(info.blocks) + " blocks, " +
+                      std::to_string(mapper_.map().grid().known_voxels()) + " known voxels)";
+    } catch (const MapIoError& e) {
+      if (!options_.ignore_bad_checkpoint) {
+        throw MapIoError(std::string(e.what()) + " (--ignore-bad-checkpoint starts with an empty map instead)");
+      }
+      const std::string bad = checkpoint_path_ + ".bad";
+      fs::rename(path, bad, ec);
+      startup_note_ = std::string("ignored the unreadable checkpoint: ") + e.what() + "; " +
+                      (ec ? "could not move it aside (" + ec.message() + ")" : "moved to " + bad) +
+                      "; starting with an empty map";
+      fs::remove(journal_path(checkpoint_path_), ec);  // its deltas continue that map, not an empty one
+    }
   }
-  try {
+  if (const int64_t n = replay_journal(base_seq); n > 0) {
+    // The journal's deltas are in the map now: a checkpoint holds them, and loading it back
+    // makes the sequence jump past every delta sent, so each client resynchronises by snapshot.
+    mapper_.save_checkpoint(checkpoint_path_, now_);
     const CheckpointInfo info = mapper_.load_checkpoint(checkpoint_path_);
     checkpoint_seq_ = mapper_.seq();
-    startup_note_ = "restored " + checkpoint_path_ + " (seq " + std::to_string(info.seq) + ", " +
-                    std::to_string(info.blocks) + " blocks, " +
-                    std::to_string(mapper_.map().grid().known_voxels()) +
-                    " known voxels); updates continue at seq " + std::to_string(mapper_.seq() + 1);
-  } catch (const MapIoError& e) {
-    if (!options_.ignore_bad_checkpoint) {
-      throw MapIoError(std::string(e.what()) + " (--ignore-bad-checkpoint starts with an empty map instead)");
-    }
-    const std::string bad = checkpoint_path_ + ".bad";
-    fs::rename(path, bad, ec);
-    startup_note_ = std::string("ignored the unreadable checkpoint: ") + e.what() + "; " +
-                    (ec ? "could not move it aside (" + ec.message() + ")" : "moved to " + bad) +
-                    "; starting with an empty map";
+    startup_note_ += "; replayed " + std::to_string(n) + " map updates from " + journal_path(checkpoint_path_) +
+                     " (to seq " + std::to_string(info.seq) + ")";
   }
+  if (mapper_.seq() > 0) startup_note_ += "; updates continue at seq " + std::to_string(mapper_.seq() + 1);
+  journal_ = std::make_unique<runtime::StateJournal>(journal_path(checkpoint_path_), kJournalKind, true);
+}
+
+int64_t MapperNode::replay_journal(int64_t checkpoint_seq) {
+  const std::string file = journal_path(checkpoint_path_);
+  std::vector<std::vector<uint8_t>> records;
+  try {
+    records = runtime::read_state_journal(file, kJournalKind);
+  } catch (const runtime::StateFileError& e) {
+    startup_note_ += std::string("; ignored ") + e.what();
+    return 0;
+  }
+  int64_t replayed = 0, last = checkpoint_seq;
+  for (const auto& rec : records) {
+    semx::map_update_t m;
+    map::MapDelta d;
+    try {
+      if (m.decode(rec.data(), 0, static_cast<int>(rec.size())) != static_cast<int>(rec.size())) break;
+    } catch (const std::exception&) {
+      break;
+    }
+    if (!map::accept_update(m) || !map::from_message(m, d)) break;
+    if (d.seq <= checkpoint_seq) continue;  // written before the checkpoint that holds it
+    if (d.seq != last + 1) break;           // not this map's next delta: stop where it stops
+    mapper_.replay_delta(d);
+    last = d.seq;
+    if (!have_time_ || d.utime > now_) now_ = d.utime;
+    have_time_ = true;
+    ++replayed;
+  }
+  return replayed;
 }
 
 int64_t MapperNode::frames_malformed() const {
@@ -192,6 +239,14 @@ void MapperNode::finish(Job& job) {
   }
   if (!have_time_ || job.frame.utime > now_) now_ = job.frame.utime;
   have_time_ = true;
+  if (journal_) {
+    try {
+      journal_->append(job.update_bytes);
+    } catch (const runtime::StateFileError& e) {
+      std::cerr << node_.name() << ": " << e.what() << " (map updates are no longer journaled)\n";
+      journal_.reset();
+    }
+  }
   node_.publish_raw(ch::MAP_UPDATE, job.update_bytes.data(), job.update_bytes.size());
   ++counters_.updates;
   if (job.esdf) {
@@ -360,6 +415,7 @@ bool MapperNode::checkpoint_now() {
     checkpoint_seq_ = mapper_.seq();
     ++counters_.checkpoints;
     checkpoint_failing_ = false;
+    if (journal_) journal_->clear();  // the checkpoint holds every delta journaled
     return true;
   } catch (const MapIoError& e) {
     ++counters_.checkpoint_errors;

@@ -46,11 +46,13 @@
 #include "semx/mapper/mapper.hpp"
 #include "semx/runtime/frame_gate.hpp"
 #include "semx/runtime/node.hpp"
+#include "semx/runtime/state_file.hpp"
 
 namespace semx::mapper {
 
 struct MapperNodeOptions {
-  // Checkpoint file; empty: config.checkpoint.path. Loaded at construction when it exists.
+  // Checkpoint file; empty: config.checkpoint.path. Loaded at construction when it exists, with
+  // the deltas published after it (<checkpoint>.journal).
   std::string checkpoint_path;
   // A checkpoint that exists but cannot be loaded: start with an empty map instead of failing
   // (the bad file is renamed to <path>.bad so the next checkpoint does not destroy the evidence).
@@ -152,6 +154,9 @@ class MapperNode {
   void publish_stats();
   void periodic();
   void restore_checkpoint();
+  // Replays <checkpoint>.journal (the deltas published since the checkpoint) onto the restored
+  // map; returns how many.
+  int64_t replay_journal(int64_t checkpoint_seq);
   void update_state();
 
   runtime::Node& node_;
@@ -172,6 +177,9 @@ class MapperNode {
   int64_t next_checkpoint_ = -1;
   int64_t checkpoint_seq_ = 0;  // map seq of the last checkpoint written or loaded (0: the empty map)
   bool checkpoint_failing_ = false;
+  // Every MAP_UPDATE since the last checkpoint, written before it is published: a mapper killed
+  // between checkpoints comes back with every delta its clients were sent.
+  std::unique_ptr<runtime::StateJournal> journal_;
   bool request_pending_ = false;
   // When the node last handled a message (wall): the clock's silence is measured from it.
   std::chrono::steady_clock::time_point last_heard_ = std::chrono::steady_clock::now();

@@ -1,6 +1,10 @@
 #include "semx/mapper/mapper.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
 
 namespace semx::mapper {
 
@@ -77,6 +81,31 @@ CheckpointInfo Mapper::load_checkpoint(const std::string& path) {
   seq_ = info.seq + kRestoreSequenceJump;
   esdf_stale_ = true;
   return info;
+}
+
+void Mapper::replay_delta(const map::MapDelta& delta) {
+  if (std::abs(delta.resolution - map_.resolution()) > 1e-9 * map_.resolution()) {
+    throw MapIoError("map delta " + std::to_string(delta.seq) + " has " + std::to_string(delta.resolution) +
+                     " m voxels, the map " + std::to_string(map_.resolution()) + " m");
+  }
+  // Values that classify as the state whatever the threshold.
+  const float occupied = std::max(map_.hit_log_odds(), map_.threshold_log_odds());
+  const float free = std::min(map_.miss_log_odds(),
+                              std::nextafter(map_.threshold_log_odds(), -std::numeric_limits<float>::infinity()));
+  for (const map::VoxelChange& c : delta.changes) {
+    switch (c.state) {
+      case map::VoxelState::kOccupied:
+        map_.set_log_odds(c.key, occupied);
+        break;
+      case map::VoxelState::kFree:
+        map_.set_log_odds(c.key, free);
+        break;
+      default:
+        map_.set_log_odds(c.key, std::numeric_limits<float>::quiet_NaN());
+        break;
+    }
+  }
+  esdf_stale_ = true;
 }
 
 }  // namespace semx::mapper

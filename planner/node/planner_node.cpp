@@ -29,7 +29,7 @@ PlannerNode::PlannerNode(runtime::NodeOptions options, const PlannerConfig& conf
   node_.subscribe<semx::controller_status_t>(
       semx::channels::CONTROLLER_STATUS,
       [this](const semx::controller_status_t& m) {
-        planner_.on_controller_status(static_cast<ControllerState>(m.state), m.plan_id);
+        planner_.on_controller_status(static_cast<ControllerState>(m.state), m.plan_id, m.utime);
       },
       accept_controller_status);
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });

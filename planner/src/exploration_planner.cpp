@@ -35,7 +35,7 @@ void ExplorationPlanner::reset() {
   pending_ = Pending();
   last_status_ = StatusReport();
   unobservable_.clear();
-  arrived_utime_ = short_since_ = -1;
+  arrived_utime_ = short_since_ = released_utime_ = -1;
   yields_.clear();
   open_known_ = -1;
   if (grid_) frontiers_.reset(*grid_);
@@ -66,8 +66,18 @@ void ExplorationPlanner::set_pose(const VehiclePose& pose) {
   pose_ = pose;
 }
 
-void ExplorationPlanner::on_controller_status(ControllerState state, int64_t plan_id) {
+void ExplorationPlanner::on_controller_status(ControllerState state, int64_t plan_id, int64_t utime) {
   if (!goal_.valid) return;
+  const int64_t lost_after = std::llround(config_.loop.lost_path_s * 1e6);
+  if (plan_id <= 0 && (state == ControllerState::kIdle || state == ControllerState::kStaleInput) &&
+      utime >= 0 && released_utime_ >= 0 && utime - released_utime_ >= lost_after && !controller_trigger_) {
+    // A controller that has taken a path never reports plan 0 again in an episode: this one was
+    // restarted, and our path is not flown any more.
+    controller_trigger_ = true;
+    controller_rejected_ = false;
+    controller_reason_ = "the controller has no path (restarted): planning again";
+    return;
+  }
   if (plan_id != plan_id_) {
     // A plan id this planner never sent (ids count up from 1): the controller took someone else's
     // path, so ours is not flown any more. Once it rejected or stopped on that path, the vehicle
@@ -409,6 +419,7 @@ void ExplorationPlanner::release(Output& out, int64_t utime) {
       if (goal_.valid) open_yield(goal_.gain);
       controller_holding_ = false;
       arrived_utime_ = short_since_ = -1;
+      released_utime_ = utime;
       PlannedPath path;
       path.plan_id = ++plan_id_;
       path.waypoints = p.goal.waypoints;

@@ -132,6 +132,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("yaw_tolerance", c.loop.yaw_tolerance, 0.0, 7.0);
   l.get("dwell_s", c.loop.dwell_s, 0.0, 3600.0);
   l.get("short_hold_s", c.loop.short_hold_s, 0.0, 3600.0);
+  l.get("lost_path_s", c.loop.lost_path_s, 0.0, 3600.0);
   l.get("hysteresis", c.loop.hysteresis, 1.0, 1e6);
   l.get("done_cycles", c.loop.done_cycles, 1, 1000000);
   l.get("max_recovery_cycles", c.loop.max_recovery_cycles, 1, 1000000);

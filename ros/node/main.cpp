@@ -24,7 +24,11 @@ int main(int argc, char** argv) {
     if (!mode.empty()) overrides.push_back("mode=" + mode);
     const auto config = load_config<semx::rosbridge::BridgeConfig>(config_file, overrides);
 
-    semx::rosbridge::BridgeNode bridge(flags.options(), config);
+    auto options = flags.options();
+    // Mirroring shows a run and changes nothing of it: a bridge that joins late or misses a frame
+    // makes ROS's picture incomplete, not the run invalid (and it is not owed the set's past).
+    options.observer = config.mode == semx::rosbridge::BridgeMode::kMirror;
+    semx::rosbridge::BridgeNode bridge(options, config);
     install_shutdown_handlers();
     const char* master = std::getenv("ROS_MASTER_URI");
     std::cout << "semx-ros-bridge: " << semx::rosbridge::to_string(config.mode) << " mode, ROS master "

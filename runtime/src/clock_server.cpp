@@ -55,6 +55,15 @@ std::optional<ClockTick> ClockServer::poll(double wall_s, bool inputs_held) {
   return std::nullopt;
 }
 
+void ClockServer::resume(int64_t tick, double wall_s) {
+  tick_ = std::max<int64_t>(tick, 0);
+  const double rate = config_.mode == ClockMode::kRealtime ? config_.speed : config_.max_speed;
+  start_wall_ = wall_s - (rate > 0 ? static_cast<double>(tick_) * config_.period_us * 1e-6 / rate : 0.0);
+  tick_sent_at_ = wall_s;
+  last_send_ = wall_s - config_.resend_after_s;  // due for resending at once
+  acks_.clear();
+}
+
 bool ClockServer::on_ack(const std::string& node, int64_t tick, int64_t quiet_until, double wall_s) {
   if (config_.mode != ClockMode::kLockstep || tick > tick_ || tick < 0) return false;
   NodeAcks& a = acks_[node];

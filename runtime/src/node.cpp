@@ -320,7 +320,7 @@ void Node::dispatch(const std::string& channel, const uint8_t* data, std::size_t
 }
 
 void Node::on_resend_request(const semx::resend_t& r) {
-  if (static_cast<uint64_t>(r.sender) != signer_.sender() || !sender_ && !lcm_) return;
+  if (static_cast<uint64_t>(r.sender) != signer_.sender() || (!sender_ && !lcm_)) return;
   // A bounded answer: a request cannot make a node send its whole history in one go.
   const uint32_t first = static_cast<uint32_t>(r.first_seq);
   const uint32_t last = std::min<uint32_t>(static_cast<uint32_t>(r.last_seq), first + 255);
@@ -632,6 +632,7 @@ semx::node_status_t Node::status() const {
   s.wall_utime = wall_utime();
   s.node = options_.name;
   s.pid = static_cast<int32_t>(getpid());
+  s.restarts = options_.restarts;
   s.state = static_cast<int8_t>(state_);
   s.detail = detail_;
   s.received = counters_.received;

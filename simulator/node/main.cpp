@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "semx/runtime/node_flags.hpp"
+#include "semx/runtime/restart_count.hpp"
 #include "semx/simulator/world.hpp"
 #include "simulator_node.hpp"
 
@@ -11,7 +12,7 @@ using namespace semx;
 int main(int argc, char** argv) {
   return runtime::run_main("semx-simulator", [&] {
     runtime::NodeFlags flags("simulator");
-    std::string world = "env1", config_file, clock = "realtime", nodes;
+    std::string world = "env1", config_file, clock = "realtime", nodes, state;
     std::vector<std::string> sets;
     double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10, ready_timeout = 30;
     bool compress = false, raw = false, no_rgb = false;
@@ -39,6 +40,10 @@ int main(int argc, char** argv) {
             "wall seconds to wait for every --lockstep-nodes node's NODE_STATUS before the first tick "
             "(default 30)",
             &ready_timeout)
+        .option("state", "FILE",
+                "save the simulation's state here every tick; restarted by the launcher (SEMX_RESTART > 0), "
+                "resume the episode from it",
+                &state)
         .flag("compress", "zlib-compress every image payload (smaller logs, slower)", &compress)
         .flag("raw-images", "send every image uncompressed (default: labels and RGB run-length coded)", &raw)
         .flag("no-rgb", "do not render or publish CAMERA_RGB", &no_rgb);
@@ -73,6 +78,8 @@ int main(int argc, char** argv) {
     if (no_rgb) o.render_channels = simulator::kRenderDepth | simulator::kRenderLabels;
     o.progress_every_s = progress;
     o.ready_timeout_s = ready_timeout;
+    o.state_path = state;
+    o.resume = !state.empty() && runtime::restart_count() > 0;
 
     auto node_options = flags.options();
     node_options.follow_clock = false;  // it is the clock
@@ -80,6 +87,12 @@ int main(int argc, char** argv) {
     runtime::install_shutdown_handlers();
     std::cout << "semx-simulator: world " << sim.world().name << " (" << path << "), " << clock
               << " clock on " << node.url() << "\n";
-    return simulator::SimulatorNode(sim, node, o).run();
+    simulator::SimulatorNode sim_node(sim, node, o);
+    if (sim_node.resumed_at() >= 0) {
+      std::cout << "semx-simulator: resumed from " << state << " at tick " << sim_node.resumed_at() << " (t="
+                << static_cast<double>(sim.time_us()) * 1e-6 << " s, restart " << runtime::restart_count()
+                << ")" << std::endl;
+    }
+    return sim_node.run();
   });
 }

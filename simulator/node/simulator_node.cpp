@@ -23,6 +23,7 @@ namespace {
 double wall_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+constexpr uint32_t kStateKind = runtime::state_kind("SIMS");
 }  // namespace
 
 SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeOptions options)
@@ -33,8 +34,15 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     server_.on_ack(a.node, a.tick, a.quiet_until, wall_seconds());
   });
   next_progress_s_ = options_.progress_every_s;
+  if (!options_.state_path.empty()) {
+    // Read before the slot is opened, which empties the file.
+    const auto saved = options_.resume ? runtime::read_state_slot(options_.state_path, kStateKind)
+                                       : std::optional<std::vector<uint8_t>>();
+    if (saved) restore_state(*saved, wall_seconds());
+    state_ = std::make_unique<runtime::StateSlot>(options_.state_path, kStateKind);
+  }
   const auto& nodes = options_.clock.lockstep_nodes;
-  if (!nodes.empty()) {
+  if (!nodes.empty() && resumed_at_ < 0) {
     ready_ = false;
     node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& s) {
       const auto& want = options_.clock.lockstep_nodes;
@@ -43,6 +51,42 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
       if (up && std::find(want.begin(), want.end(), s.node) != want.end()) heard_.insert(s.node);
     });
   }
+}
+
+void SimulatorNode::save_state(int64_t tick) {
+  state_bytes_.clear();
+  core::ByteWriter w(state_bytes_);
+  w.i64(tick);
+  w.i64(frames_);
+  w.i64(rejected_);
+  w.f64(next_progress_s_);
+  const std::vector<uint8_t> sim = sim_.save_state();
+  w.bytes(sim.data(), sim.size());
+  state_->write(state_bytes_);
+}
+
+void SimulatorNode::restore_state(const std::vector<uint8_t>& bytes, double wall_s) {
+  core::ByteReader r(bytes.data(), bytes.size());
+  int64_t tick = 0;
+  try {
+    tick = r.i64();
+    frames_ = r.i64();
+    rejected_ = r.i64();
+    next_progress_s_ = r.f64();
+  } catch (const std::out_of_range&) {
+    throw runtime::StateFileError(options_.state_path + ": truncated simulator state");
+  }
+  const std::size_t header = bytes.size() - r.remaining();
+  try {
+    sim_.restore_state(std::vector<uint8_t>(bytes.begin() + static_cast<std::ptrdiff_t>(header), bytes.end()));
+  } catch (const std::runtime_error& e) {
+    throw runtime::StateFileError(options_.state_path + ": " + e.what());
+  }
+  // The episode started long ago: no start event, no initial frame, no waiting for the nodes
+  // (they are running; the resent tick reaches whoever listens).
+  started_ = true;
+  server_.resume(tick, wall_s);
+  resumed_at_ = tick;
 }
 
 bool SimulatorNode::check_ready(double wall_s) {
@@ -130,7 +174,12 @@ bool SimulatorNode::poll(double wall_s) {
   // A command an ack named but that was lost on the way is asked for again before the next
   // tick: the vehicle must fly the run a lossless bus gives.
   if (auto t = server_.poll(wall_s, node_.holds_everything())) {
-    if (!t->resend) advance_to(t->utime);
+    if (!t->resend) {
+      advance_to(t->utime);
+      // Saved before the tick goes out: a simulator killed after this resends this tick, one
+      // killed before it steps to it again from the last (its sensors' outputs then twice).
+      if (state_) save_state(t->tick);
+    }
     publish_clock(*t);
     if (!t->resend) server_.mark_published(wall_seconds());
     const double sim_s = static_cast<double>(t->utime) * 1e-6;

@@ -12,12 +12,15 @@
 #include <semx/control_cmd_t.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "semx/runtime/clock_server.hpp"
 #include "semx/runtime/image_codec.hpp"
 #include "semx/runtime/node.hpp"
+#include "semx/runtime/state_file.hpp"
 #include "semx/simulator/simulator.hpp"
 
 namespace semx::simulator {
@@ -35,6 +38,11 @@ struct SimulatorNodeOptions {
   // Wall seconds to wait for the registered nodes before starting without the silent ones (named
   // on stderr; in LOCKSTEP the clock still waits for their acks).
   double ready_timeout_s = 30.0;
+  // Where to save the simulation's state every tick (empty: nowhere), and whether to resume from
+  // what is there (a restart after a crash): the episode then goes on from the last tick
+  // published, which is sent again, never an earlier one (docs/launch.md, "When a process dies").
+  std::string state_path;
+  bool resume = false;
 };
 
 class SimulatorNode {
@@ -52,6 +60,8 @@ class SimulatorNode {
   int64_t commands_rejected() const { return rejected_; }
   // Every registered node was heard (or the wait timed out); true at once with none registered.
   bool ready() const { return ready_; }
+  // The tick it resumed at (-1: it started the episode).
+  int64_t resumed_at() const { return resumed_at_; }
 
  private:
   void advance_to(int64_t utime);
@@ -62,6 +72,8 @@ class SimulatorNode {
   void on_command(const semx::control_cmd_t& m);
   // Before the first tick: whether to start now (everyone heard, or the wait timed out).
   bool check_ready(double wall_s);
+  void save_state(int64_t tick);
+  void restore_state(const std::vector<uint8_t>& bytes, double wall_s);
 
   Simulator& sim_;
   runtime::Node& node_;
@@ -76,6 +88,9 @@ class SimulatorNode {
   bool ready_ = true;
   double wait_start_ = -1;
   std::set<std::string> heard_;  // registered nodes heard running
+  std::unique_ptr<runtime::StateSlot> state_;
+  std::vector<uint8_t> state_bytes_;
+  int64_t resumed_at_ = -1;
 };
 
 }  // namespace semx::simulator

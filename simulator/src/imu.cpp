@@ -39,4 +39,16 @@ ImuSample ImuModel::sample(int64_t utime, const VehicleState& state) {
   return s;
 }
 
+void ImuModel::save(core::ByteWriter& w) const {
+  rng_.save(w);
+  for (int i = 0; i < 3; ++i) w.f64(accel_bias_[i]);
+  for (int i = 0; i < 3; ++i) w.f64(gyro_bias_[i]);
+}
+
+void ImuModel::restore(core::ByteReader& r) {
+  rng_.restore(r);
+  for (int i = 0; i < 3; ++i) accel_bias_[i] = r.f64();
+  for (int i = 0; i < 3; ++i) gyro_bias_[i] = r.f64();
+}
+
 }  // namespace semx::simulator

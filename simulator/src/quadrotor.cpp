@@ -192,4 +192,53 @@ StepReport Quadrotor::step(double dt) {
   return report;
 }
 
+namespace {
+void put(core::ByteWriter& w, const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) w.f64(v[i]);
+}
+Eigen::Vector3d get_vec(core::ByteReader& r) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = r.f64();
+  return v;
+}
+}  // namespace
+
+void Quadrotor::save(core::ByteWriter& w) const {
+  put(w, state_.position);
+  put(w, state_.velocity);
+  put(w, state_.acceleration);
+  w.f64(state_.yaw);
+  w.f64(state_.yaw_rate);
+  w.i32(cmd_.mode);
+  put(w, cmd_.setpoint);
+  w.i32(cmd_.yaw_mode);
+  w.f64(cmd_.yaw);
+  w.f64(cmd_.yaw_rate);
+  put(w, hold_position_);
+  w.u8(in_contact_ ? 1 : 0);
+  w.i32(contact_solid_);
+  w.i64(collisions_);
+  w.i64(blocked_steps_);
+  w.i64(rejected_);
+}
+
+void Quadrotor::restore(core::ByteReader& r) {
+  state_.position = get_vec(r);
+  state_.velocity = get_vec(r);
+  state_.acceleration = get_vec(r);
+  state_.yaw = r.f64();
+  state_.yaw_rate = r.f64();
+  cmd_.mode = r.i32();
+  cmd_.setpoint = get_vec(r);
+  cmd_.yaw_mode = r.i32();
+  cmd_.yaw = r.f64();
+  cmd_.yaw_rate = r.f64();
+  hold_position_ = get_vec(r);
+  in_contact_ = r.u8() != 0;
+  contact_solid_ = r.i32();
+  collisions_ = r.i64();
+  blocked_steps_ = r.i64();
+  rejected_ = r.i64();
+}
+
 }  // namespace semx::simulator

@@ -1,6 +1,8 @@
 #include "semx/simulator/simulator.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "semx/core/random.hpp"
 
@@ -123,6 +125,65 @@ void Simulator::render_camera(CameraFrame& out, unsigned channels) {
   if (channels & kRenderLabels) {
     apply_detection_noise(out, config_.detection_noise,
                           core::mix_seed(core::mix_seed(config_.seed, kDetectionStream), id));
+  }
+}
+
+namespace {
+constexpr uint32_t kStateVersion = 1;
+}  // namespace
+
+std::vector<uint8_t> Simulator::save_state() const {
+  std::vector<uint8_t> out;
+  core::ByteWriter w(out);
+  w.u32(kStateVersion);
+  // What the state is only valid for: the same world, seed and step.
+  w.str(world_->name);
+  w.u64(config_.seed);
+  w.i64(config_.step_us);
+  w.i64(time_us_);
+  w.i64(camera_count_);
+  w.i64(imu_count_);
+  w.i64(odom_count_);
+  w.i64(last_command_us_);
+  w.u8(timed_out_ ? 1 : 0);
+  w.i64(timeouts_);
+  vehicle_->save(w);
+  imu_.save(w);
+  return out;
+}
+
+void Simulator::restore_state(const std::vector<uint8_t>& bytes) {
+  core::ByteReader r(bytes.data(), bytes.size());
+  try {
+    if (r.u32() != kStateVersion) throw std::runtime_error("simulator state of another version");
+    const std::string world = r.str();
+    const uint64_t seed = r.u64();
+    const int64_t step = r.i64();
+    if (world != world_->name || seed != config_.seed || step != config_.step_us) {
+      throw std::runtime_error("simulator state of another run (world '" + world + "', seed " +
+                               std::to_string(seed) + ", step " + std::to_string(step) + " us)");
+    }
+    const int64_t time_us = r.i64();
+    const int64_t camera = r.i64(), imu = r.i64(), odom = r.i64(), last_command = r.i64();
+    const bool timed_out = r.u8() != 0;
+    const int64_t timeouts = r.i64();
+    // Into copies first, so a short file leaves this simulator as it was.
+    Quadrotor vehicle(*world_, config_.vehicle);
+    vehicle.restore(r);
+    ImuModel imu_model = imu_;
+    imu_model.restore(r);
+    if (r.remaining() != 0) throw std::runtime_error("simulator state has trailing bytes");
+    vehicle_ = std::make_unique<Quadrotor>(std::move(vehicle));
+    time_us_ = time_us;
+    camera_count_ = camera;
+    imu_count_ = imu;
+    odom_count_ = odom;
+    last_command_us_ = last_command;
+    timed_out_ = timed_out;
+    timeouts_ = timeouts;
+    imu_ = imu_model;
+  } catch (const std::out_of_range&) {
+    throw std::runtime_error("simulator state is truncated");
   }
 }
 

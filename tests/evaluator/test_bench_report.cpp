@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <string>
 
@@ -76,9 +77,9 @@ TEST(BenchReport, TablesGiveMeansOverSeedsAndTheMarginsOfSemanticDep) {
   const std::string csv = bench_csv(runs);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-            "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s");
+            "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s,disturbed");
   // A run folder from before Time_95 and the end game leaves their columns empty.
-  EXPECT_NE(csv.find(",80.000,30.000,,,\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",80.000,30.000,,,,false\n"), std::string::npos) << csv;
 }
 
 // Seed by seed: only seeds both reached 85 % in count; ties within 0.05 s are the same flight;
@@ -151,11 +152,41 @@ TEST(BenchReport, EveryPlannerIsDividedByTheOracleAndTheEndGameIsTabled) {
   // The comparison table ends with Time_95 and the end game.
   EXPECT_NE(md.find("| 50.00 ± 14.14 | 110.00 ± 14.14 |"), std::string::npos) << md;
   const std::string csv = bench_csv(runs);
-  EXPECT_NE(csv.find("time_95_s,time_settled_s,end_game_s\n"), std::string::npos);
-  EXPECT_NE(csv.find(",40.000,100.000,100.000\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("time_95_s,time_settled_s,end_game_s,disturbed\n"), std::string::npos);
+  EXPECT_NE(csv.find(",40.000,100.000,100.000,false\n"), std::string::npos) << csv;
   // Without an oracle run there is no such table.
   fs::remove_all(fs::path(root) / "env2-oracle-s45-seed1");
   EXPECT_EQ(bench_markdown(load_bench_runs(root)).find("known-map oracle"), std::string::npos);
+}
+
+// A run during which a process died and was restarted is no sample of the planner: it stays out
+// of every table and plot and is listed under them with what restarted when.
+TEST(BenchReport, DisturbedRunsAreListedUnderTheTablesNotInThem) {
+  const std::string root = test::temp_dir("bench_disturbed");
+  write_run(root, "env1", "semantic-dep", 1, 100, 10, 30);
+  write_run(root, "env1", "semantic-dep", 2, 100, 20, 50);
+  write_run(root, "env1", "semantic-dep", 3, 300, 90, 90);
+  {
+    // Seed 3 was disturbed: the evaluator's two fields, as it writes them.
+    const std::string m = root + "/env1-semantic-dep-s45-seed3/metrics.json";
+    std::ifstream in(m);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.insert(text.find("  \"termination\""),
+                "  \"disturbed\": true,\n  \"restarts\": [{\"node\": \"mapper\", \"t_s\": 12.5, "
+                "\"restarts\": 1}],\n");
+    std::ofstream(m) << text;
+  }
+  const auto runs = load_bench_runs(root);
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_TRUE(runs[2].disturbed);
+  EXPECT_EQ(runs[2].restarts, "mapper 12.5 s");
+  const std::string md = bench_markdown(runs);
+  EXPECT_NE(md.find("| env1 | semantic-dep | 2 | 100.00 ± 0.00 |"), std::string::npos)
+      << "the table has the two undisturbed seeds:\n" << md;
+  const auto listed = md.find("### Disturbed runs");
+  ASSERT_NE(listed, std::string::npos) << md;
+  EXPECT_NE(md.find("| env1 | semantic-dep | 45 | 3 | mapper 12.5 s | 300.00 |", listed), std::string::npos) << md;
+  EXPECT_NE(bench_csv(runs).find(",true\n"), std::string::npos) << "the CSV keeps every run, marked";
 }
 
 TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {

@@ -241,5 +241,105 @@ TEST(Evaluation, CoverageFromDeltasAndTheGroundTruthFollowsTheMapsResolution) {
   EXPECT_EQ(ev.map_deltas(), 5);
 }
 
+// semx-evaluator's journal: an evaluator killed mid-run and restored from the records it had
+// saved (one per coverage sample), then fed the map's snapshot and the rest of the run, ends with
+// the figures, series and trajectory of the one that was never killed.
+TEST(Evaluation, RestoredFromItsJournalItEndsAsTheUndisturbedOne) {
+  const simulator::GroundTruth gt(test::small_world(), 0.1);
+  const auto deltas = test::sweep_deltas(gt, 20, kS / 2, kS / 2);
+  Evaluation a(test::small_world(), {});
+  std::vector<std::vector<uint8_t>> journal;
+  Evaluation::Saved saved;
+  map::StateGrid grid(0.1), grid_b(0.1);
+  size_t next_delta = 0;
+  // One run's events up to `until` (utime), fed to `e`; `grid` follows the deltas.
+  auto feed = [&](Evaluation& e, map::StateGrid& grid, int64_t from, int64_t until, bool save) {
+    for (int64_t t = from; t < until; t += kS / 10) {
+      const double x = 0.3 * static_cast<double>(t) / kS;
+      e.on_odometry(t, Eigen::Vector3d(x, std::sin(x), 1.0));
+      if (next_delta < deltas.size() && deltas[next_delta].utime <= t) {
+        for (const auto& c : deltas[next_delta].changes) grid.set_state(c.key, c.state);
+        e.on_map_delta(deltas[next_delta++], grid);
+      }
+      if (t == 3 * kS) e.on_collision(t, 1);
+      if (t == 4 * kS) e.on_node_status("mapper", 100, 0, t);
+      if (t == 5 * kS) e.on_planner_status(t, "dep", PlannerState::kExecuting);
+      const size_t before = e.metrics().samples().size();
+      e.advance(t);
+      if (save && e.metrics().samples().size() != before) {
+        std::vector<uint8_t> rec;
+        core::ByteWriter w(rec);
+        e.save(w, saved);
+        journal.push_back(std::move(rec));
+      }
+    }
+  };
+  feed(a, grid, 0, 6 * kS + kS / 10, true);
+  // The crash: b is a new evaluator that reads the journal back, then hears the mapper's snapshot.
+  Evaluation b(test::small_world(), {});
+  for (const auto& rec : journal) {
+    core::ByteReader r(rec.data(), rec.size());
+    b.restore(r);
+    EXPECT_EQ(r.remaining(), 0u);
+  }
+  EXPECT_EQ(b.metrics().samples().size(), a.metrics().samples().size());
+  EXPECT_DOUBLE_EQ(b.metrics().distance_m(), a.metrics().distance_m());
+  for (size_t i = 0; i < next_delta; ++i)
+    for (const auto& c : deltas[i].changes) grid_b.set_state(c.key, c.state);
+  b.on_map_reset(grid_b, 6 * kS + kS / 10, deltas[next_delta - 1].seq);
+  EXPECT_EQ(b.tracker().covered(), a.tracker().covered());
+  b.on_node_status("mapper", 200, 1, 7 * kS);  // the mapper came back too
+  a.on_node_status("mapper", 200, 1, 7 * kS);
+  // The rest of the run, to both.
+  const size_t resume_delta = next_delta;
+  feed(a, grid, 6 * kS + kS / 10, 12 * kS, false);
+  next_delta = resume_delta;
+  feed(b, grid_b, 6 * kS + kS / 10, 12 * kS, false);
+  a.on_planner_status(12 * kS, "dep", PlannerState::kDone);
+  b.on_planner_status(12 * kS, "dep", PlannerState::kDone);
+  a.finish(Termination::kStopped, 12 * kS, 3.0);
+  b.finish(Termination::kStopped, 12 * kS, 3.0);
+  const RunSummary sa = a.summary(), sb = b.summary();
+  EXPECT_EQ(sb.termination, "planner_done");
+  EXPECT_EQ(sb.info.planner, "dep");
+  EXPECT_DOUBLE_EQ(sb.time_f_s, sa.time_f_s);
+  EXPECT_DOUBLE_EQ(sb.distance_m, sa.distance_m);
+  EXPECT_DOUBLE_EQ(sb.coverage_pct, sa.coverage_pct);
+  EXPECT_EQ(sb.time_r_s, sa.time_r_s);
+  EXPECT_EQ(sb.time_95_s, sa.time_95_s);
+  EXPECT_EQ(sb.time_settled_s, sa.time_settled_s);
+  EXPECT_EQ(sb.time_o_s, sa.time_o_s);
+  EXPECT_EQ(sb.collisions, 1);
+  ASSERT_EQ(sb.coverage.size(), sa.coverage.size());
+  for (size_t i = 0; i < sa.coverage.size(); ++i) {
+    EXPECT_DOUBLE_EQ(sb.coverage[i].t_s, sa.coverage[i].t_s);
+    EXPECT_DOUBLE_EQ(sb.coverage[i].coverage_pct, sa.coverage[i].coverage_pct) << i;
+    EXPECT_DOUBLE_EQ(sb.coverage[i].distance_m, sa.coverage[i].distance_m) << i;
+  }
+  EXPECT_EQ(sb.trajectory, sa.trajectory);
+  ASSERT_EQ(sb.restarts.size(), 1u);
+  EXPECT_EQ(sb.restarts[0].node, "mapper");
+  EXPECT_DOUBLE_EQ(sb.restarts[0].t_s, 7.0);
+  EXPECT_EQ(sb.restarts[0].restarts, 1);
+}
+
+TEST(Evaluation, ANodeThatComesBackMarksTheRunDisturbed) {
+  Evaluation ev(test::small_world(), {});
+  ev.on_node_status("mapper", 10, 0, 1 * kS);
+  ev.on_node_status("mapper", 10, 0, 2 * kS);
+  ev.on_node_status("planner", 11, 0, 2 * kS);
+  EXPECT_TRUE(ev.restarts().empty()) << "the same processes, heard again";
+  ev.on_node_status("mapper", 12, 1, 3 * kS);     // respawned by the launcher
+  ev.on_node_status("planner", 13, 0, 4 * kS);    // another pid without a launcher restart
+  ev.on_node_status("semantics", 14, 2, 5 * kS);  // first heard after two restarts
+  const RunSummary s = ev.summary();
+  ASSERT_EQ(s.restarts.size(), 3u);
+  EXPECT_EQ(s.restarts[0].node, "mapper");
+  EXPECT_DOUBLE_EQ(s.restarts[0].t_s, 3.0);
+  EXPECT_EQ(s.restarts[1].node, "planner");
+  EXPECT_EQ(s.restarts[1].restarts, 0);
+  EXPECT_EQ(s.restarts[2].restarts, 2);
+}
+
 }  // namespace
 }  // namespace semx::evaluator

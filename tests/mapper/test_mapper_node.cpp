@@ -20,6 +20,7 @@
 #include "mapper_messages.hpp"
 #include "mapper_node.hpp"
 #include "mapper_test_util.hpp"
+#include "semx/map/map_mirror.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_url.hpp"
 
@@ -656,6 +657,69 @@ TEST(MapperNode, CheckpointsOnMessageTimeAndRestoresOnStart) {
   EXPECT_EQ(wire.all<semx::map_update_t>(ch::MAP_UPDATE)[0].seq,
             seq_saved + Mapper::kRestoreSequenceJump + 1);
   std::remove(path.c_str());
+}
+
+// A mapper killed between checkpoints (no checkpoint on exit) comes back with every delta it
+// had sent: the checkpoint, then the journal of the deltas published after it. A delta the crash
+// cut short in the journal was never sent (the journal is written first) and is left out.
+TEST(MapperNode, AKilledMapperComesBackWithEveryDeltaItSent) {
+  const auto cam = test::small_camera();
+  const auto frames = test::room_frames(5, cam, 4);
+  const std::string path = temp_file("killed.ckpt");
+  std::remove(path.c_str());
+  std::remove((path + ".journal").c_str());
+  MapperConfig cfg = small_config();
+  cfg.checkpoint.path = path;
+  cfg.checkpoint.period = 1.0;
+  std::vector<semx::map_update_t> sent;
+  {
+    runtime::Node node(memq_node());
+    Wire wire(node);
+    MapperNode mn(node, cfg);
+    const int64_t at[] = {0, 500000, 1000000, 1200000, 1400000};
+    for (int i = 0; i < 5; ++i) node.publish(ch::CAMERA_DEPTH, frame_message(cam, frames[i], at[i]));
+    node.drain();
+    EXPECT_EQ(read_checkpoint_info(path).seq, 3) << "checkpointed at 1 s";
+    sent = wire.all<semx::map_update_t>(ch::MAP_UPDATE);
+    ASSERT_EQ(sent.size(), 5u);
+  }  // killed: no checkpoint on the way out
+  auto mirror_of = [&](size_t deltas) {
+    map::MapMirror m(cfg.occupancy.resolution);
+    for (size_t i = 0; i < deltas; ++i) {
+      map::MapDelta d;
+      EXPECT_TRUE(map::from_message(sent[i], d));
+      EXPECT_EQ(m.apply(d), map::MapMirror::DeltaResult::kApplied);
+    }
+    return m;
+  };
+  const auto journal_size = std::filesystem::file_size(path + ".journal");
+  {
+    runtime::Node node(memq_node());
+    MapperNode mn(node, cfg);
+    EXPECT_NE(mn.startup_note().find("replayed 2 map updates"), std::string::npos) << mn.startup_note();
+    expect_same(mn.mapper().map().grid(), mirror_of(5).grid());
+    EXPECT_GT(mn.mapper().seq(), sent.back().seq) << "clients see a gap and resynchronise";
+    EXPECT_EQ(std::filesystem::file_size(path + ".journal"), 0u) << "a checkpoint holds the replayed deltas";
+    EXPECT_EQ(read_checkpoint_info(path).seq + Mapper::kRestoreSequenceJump, mn.mapper().seq());
+  }
+  // Once more, with the last journal record cut short: the deltas before it come back.
+  std::remove(path.c_str());
+  {
+    runtime::StateJournal tmp(path + ".journal", runtime::state_kind("MAPJ"), true);
+    for (const auto& m : sent) {
+      std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
+      m.encode(b.data(), 0, static_cast<int>(b.size()));
+      tmp.append(b);
+    }
+  }
+  std::filesystem::resize_file(path + ".journal", std::filesystem::file_size(path + ".journal") - 7);
+  EXPECT_GT(journal_size, 0u);
+  runtime::Node node(memq_node());
+  MapperNode mn(node, cfg);
+  EXPECT_NE(mn.startup_note().find("replayed 4 map updates"), std::string::npos) << mn.startup_note();
+  expect_same(mn.mapper().map().grid(), mirror_of(4).grid());
+  std::remove(path.c_str());
+  std::remove((path + ".journal").c_str());
 }
 
 TEST(MapperNode, BadCheckpointIsAnErrorNamingTheFileUnlessIgnored) {

@@ -404,6 +404,21 @@ TEST(Planner, ReplansWhenTheControllerStopsOnAPathItDidNotSend) {
   EXPECT_FALSE(first_path(p, t + 3000000, t + 4000000));
 }
 
+TEST(Planner, ReplansWhenARestartedControllerHasNoPath) {
+  CorridorStart start;
+  auto& [g, p, t, first] = start;
+  ASSERT_TRUE(first);
+  // Plan 0 right after the path went out: a status sent before the controller had it.
+  p.on_controller_status(ControllerState::kIdle, 0, t + 100000);
+  EXPECT_FALSE(first_path(p, t + 10000, t + 1000000)) << "nothing lost yet";
+  // A second later the controller still has no path: it was restarted and lost ours.
+  p.on_controller_status(ControllerState::kStaleInput, 0, t + 1000000 + 10000);
+  const auto second = first_path(p, t + 1010000, t + 3000000);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->plan_id, first->plan_id + 1);
+  EXPECT_NE(p.last_status().reason.find("no path"), std::string::npos) << p.last_status().reason;
+}
+
 TEST(Planner, GivesUpAGoalTheControllerHoldsShortOf) {
   CorridorStart start;
   auto& [g, p, t, first] = start;

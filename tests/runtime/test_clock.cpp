@@ -87,6 +87,44 @@ TEST(ClockServer, LockstepResendsAStalledTick) {
   EXPECT_EQ(t->tick, 0);
 }
 
+// A restarted clock source (the simulator after a crash) goes on from the tick it published
+// last: it sends that tick again at once, waits for every node's ack of it, and never goes back.
+TEST(ClockServer, ResumesAtItsLastTickAndWaitsForEveryAckAgain) {
+  ClockServerConfig cfg;
+  cfg.mode = ClockMode::kLockstep;
+  cfg.lockstep_nodes = {"mapper", "planner"};
+  cfg.max_ticks = 500;
+  cfg.resend_after_s = 1.0;
+  ClockServer s(cfg);
+  s.resume(420, 50.0);
+  auto t = s.poll(50.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 420);
+  EXPECT_EQ(t->utime, 420 * cfg.period_us);
+  EXPECT_TRUE(t->resend) << "the nodes have had it: they ack it again without redoing it";
+  EXPECT_FALSE(s.poll(50.1));
+  EXPECT_FALSE(s.on_ack("mapper", 419)) << "an ack from before the crash does not count";
+  EXPECT_FALSE(s.on_ack("mapper", 420));
+  EXPECT_EQ(s.waiting_for(), std::vector<std::string>{"planner"});
+  EXPECT_TRUE(s.on_ack("planner", 420));
+  t = s.poll(50.2);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 421);
+  EXPECT_FALSE(t->resend);
+  EXPECT_FALSE(s.finished());
+}
+
+TEST(ClockServer, RealtimeResumeKeepsTheTickRate) {
+  ClockServerConfig cfg;
+  cfg.period_us = 10000;
+  ClockServer s(cfg);
+  s.resume(100, 7.0);
+  EXPECT_FALSE(s.poll(7.005)) << "realtime does not resend";
+  auto t = s.poll(7.0101);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->tick, 101);
+}
+
 TEST(ClockServer, RealtimeFollowsTheWallClockAtItsSpeed) {
   ClockServerConfig cfg;
   cfg.period_us = 10000;

@@ -76,7 +76,9 @@ TEST(LossyBus, EveryMessageArrivesInOrderDespiteTenPercentLoss) {
     semx::odometry_t o{};
     o.utime = i;
     ASSERT_TRUE(pub.publish("ODOMETRY", o));
-    if (i % 10 == 0) ASSERT_TRUE(pub.publish("CAMERA_DEPTH", frame(i, 600000)));
+    if (i % 10 == 0) {
+      ASSERT_TRUE(pub.publish("CAMERA_DEPTH", frame(i, 600000)));
+    }
     spin_both(pub, sub, 5);  // 200 Hz: a reader that keeps up, as a set's ticks make it
   }
   // A loss is known from a later message on the same channel, or from a tick's heads: the last

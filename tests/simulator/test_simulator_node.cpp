@@ -13,7 +13,11 @@
 #include <semx/odometry_t.hpp>
 #include <semx/sim_event_t.hpp>
 
+#include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <functional>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -50,10 +54,15 @@ SimulatorNodeOptions lockstep(int64_t ticks) {
   return o;
 }
 
-// Runs `ticks` lockstep ticks of env1 and captures every message, in publish order.
-Captured run(int64_t ticks, const std::function<void(runtime::Node&, int64_t tick)>& before_tick = nullptr) {
+// Runs `ticks` lockstep ticks of env1 and captures every message, in publish order. With
+// `stop_after` >= 0 the simulator is dropped after that tick (as if killed); `o` may save its
+// state or resume from it (then the tick count starts where it resumed).
+Captured run(int64_t ticks, const std::function<void(runtime::Node&, int64_t tick)>& before_tick = nullptr,
+             int64_t stop_after = -1, SimulatorNodeOptions o = lockstep(0)) {
   SimulatorConfig cfg;
   cfg.depth_noise.enabled = true;  // noise must be seeded too
+  cfg.detection_noise.enabled = true;
+  cfg.imu.accel_bias_random_walk = 0.01;  // the IMU's biases and generator must come back too
   Simulator sim(test::shipped("env1"), cfg);
   runtime::Node node(memq_node());
   Captured c;
@@ -61,13 +70,15 @@ Captured run(int64_t ticks, const std::function<void(runtime::Node&, int64_t tic
     c.channels.push_back(ch);
     c.payloads.emplace_back(d, d + n);
   });
-  SimulatorNode sn(sim, node, lockstep(ticks));
+  o.clock.max_ticks = ticks;
+  SimulatorNode sn(sim, node, o);
   double wall = 0;
-  int64_t tick = 0;
+  int64_t tick = sn.resumed_at() + 1;
   while (true) {
     if (before_tick) before_tick(node, tick);
     if (!sn.poll(wall += 0.001)) break;
     node.drain();
+    if (tick == stop_after) break;
     ++tick;
   }
   node.drain();
@@ -252,6 +263,113 @@ TEST(SimulatorNode, VelocityCommandsMoveTheVehicleAndBadOnesAreDropped) {
   }
   EXPECT_GT(last_x - first_x, 0.15) << "0.3 m/s for a second with a first-order response";
   EXPECT_GE(malformed, 9) << "NaN commands are counted as malformed";
+}
+
+// A simulator killed mid-episode and restarted with its state file goes on from its last tick:
+// everything it publishes after the restart is what the simulator that was never killed
+// published after that tick, byte for byte (vehicle, sensor counters, noise, IMU generator).
+TEST(SimulatorNode, ResumesFromItsStateAsIfNeverStopped) {
+  auto commands = [](runtime::Node& node, int64_t tick) {
+    semx::control_cmd_t cmd{};
+    cmd.utime = tick * 10000;
+    cmd.mode = semx::control_cmd_t::VELOCITY;
+    cmd.setpoint[0] = 0.4 * std::sin(0.05 * static_cast<double>(tick));
+    cmd.setpoint[1] = 0.2;
+    cmd.yaw_mode = semx::control_cmd_t::YAW_RATE;
+    cmd.yaw_rate = 0.5;
+    if (tick % 7 != 3) node.publish("CONTROL_CMD", cmd);
+  };
+  const Captured whole = run(160, commands);
+  const std::string state = ::testing::TempDir() + "/sim_state_" + std::to_string(getpid());
+  SimulatorNodeOptions o = lockstep(0);
+  o.state_path = state;
+  const Captured before = run(160, commands, 97, o);
+  o.resume = true;
+  const Captured after = run(160, commands, -1, o);
+  // Where the first run stopped: just after SIM_CLOCK(97).
+  auto tick_of = [](const std::vector<uint8_t>& p) {
+    semx::clock_t m{};
+    return m.decode(p.data(), 0, static_cast<int>(p.size())) > 0 ? m.tick : -1;
+  };
+  std::size_t at = 0;
+  for (; at < whole.channels.size(); ++at) {
+    if (whole.channels[at] == "SIM_CLOCK" && tick_of(whole.payloads[at]) == 97) break;
+  }
+  ASSERT_LT(at, whole.channels.size());
+  std::vector<std::size_t> rest;
+  for (std::size_t i = at + 1; i < whole.channels.size(); ++i)
+    if (whole.channels[i] != "NODE_STATUS") rest.push_back(i);
+  std::vector<std::size_t> resumed;
+  for (std::size_t i = 0; i < after.channels.size(); ++i)
+    if (after.channels[i] != "NODE_STATUS") resumed.push_back(i);
+  ASSERT_EQ(resumed.size(), rest.size());
+  ASSERT_GT(rest.size(), 100u);
+  // A tick also names its publishers and how much each has sent (docs/runtime.md, "Lost
+  // messages"): the restarted simulator is a new publisher. Its time is what must be the same.
+  const auto clock_time = [](const std::vector<uint8_t>& p) {
+    semx::clock_t m{};
+    EXPECT_GT(m.decode(p.data(), 0, static_cast<int>(p.size())), 0);
+    return std::make_tuple(m.tick, m.utime, m.mode, m.period_us);
+  };
+  for (std::size_t k = 0; k < rest.size(); ++k) {
+    ASSERT_EQ(after.channels[resumed[k]], whole.channels[rest[k]]) << k;
+    if (whole.channels[rest[k]] == "SIM_CLOCK") {
+      EXPECT_EQ(clock_time(after.payloads[resumed[k]]), clock_time(whole.payloads[rest[k]])) << " #" << k;
+      continue;
+    }
+    EXPECT_EQ(after.payloads[resumed[k]], whole.payloads[rest[k]]) << whole.channels[rest[k]] << " #" << k;
+  }
+  // No second start of the episode, and ticks only go on.
+  for (std::size_t i = 0; i < after.channels.size(); ++i) {
+    if (after.channels[i] == "SIM_CLOCK") {
+      EXPECT_GT(tick_of(after.payloads[i]), 97);
+    }
+    if (after.channels[i] == "SIM_EVENT") {
+      semx::sim_event_t e{};
+      ASSERT_GT(e.decode(after.payloads[i].data(), 0, static_cast<int>(after.payloads[i].size())), 0);
+      EXPECT_NE(e.type, semx::sim_event_t::EPISODE_START);
+    }
+  }
+  EXPECT_FALSE(before.channels.empty());
+  std::remove(state.c_str());
+}
+
+// A restarted simulator in LOCKSTEP sends its last tick again and waits for every node's ack
+// of it before it steps on.
+TEST(SimulatorNode, ResumedLockstepResendsItsLastTickAndWaitsForTheAcks) {
+  const std::string state = ::testing::TempDir() + "/sim_state_ls_" + std::to_string(getpid());
+  SimulatorNodeOptions o = lockstep(0);
+  o.state_path = state;
+  run(100, nullptr, 40, o);
+  o.resume = true;
+  o.clock.lockstep_nodes = {"mapper"};
+  o.clock.max_ticks = 100;
+  o.clock.resend_after_s = 1.0;  // one resend in this test's 0.2 s
+  SimulatorConfig cfg;
+  Simulator sim(test::shipped("env1"), cfg);
+  runtime::Node node(memq_node());
+  std::vector<int64_t> ticks;
+  node.subscribe<semx::clock_t>("SIM_CLOCK", [&](const semx::clock_t& m) { ticks.push_back(m.tick); });
+  SimulatorNode sn(sim, node, o);
+  EXPECT_EQ(sn.resumed_at(), 40);
+  EXPECT_TRUE(sn.ready()) << "the nodes are running: no waiting for their NODE_STATUS";
+  // The node resumed on the wall clock (steady_clock seconds): poll on it too.
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  sn.poll(now);
+  node.drain();
+  sn.poll(now + 0.1);
+  node.drain();
+  EXPECT_EQ(ticks, std::vector<int64_t>{40}) << "tick 40 again, and nothing more without an ack";
+  semx::ack_t ack{};
+  ack.node = "mapper";
+  ack.tick = 40;
+  node.publish("SIM_ACK", ack);
+  node.drain();
+  sn.poll(now + 0.2);
+  node.drain();
+  EXPECT_EQ(ticks, (std::vector<int64_t>{40, 41}));
+  std::remove(state.c_str());
 }
 
 TEST(SimulatorNode, SameSeedSameMessageStream) {

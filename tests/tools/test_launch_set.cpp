@@ -95,6 +95,37 @@ TEST(LaunchSet, ExitPolicy) {
   EXPECT_EQ(on_process_exit(p, 0, 0, false), ExitAction::kRestart);
 }
 
+TEST(LaunchSet, RestartsBackOffUpToTheCap) {
+  const auto set = load_launch_set(write_set("backoff.yaml", R"(name: b
+args: {out: /tmp/run}
+dirs: ["${out}/state"]
+processes:
+  - name: a
+    command: [x]
+    restart: on-failure
+    restart_delay: 0.5
+    restart_delay_max: 3
+  - name: b
+    command: [y]
+    restart_delay: 40
+)"),
+                                   {}, {});
+  EXPECT_EQ(set.dirs, std::vector<std::string>{"/tmp/run/state"});
+  const ProcessSpec& a = set.processes[0];
+  EXPECT_DOUBLE_EQ(restart_delay(a, 1), 0.5);
+  EXPECT_DOUBLE_EQ(restart_delay(a, 2), 1.0);
+  EXPECT_DOUBLE_EQ(restart_delay(a, 3), 2.0);
+  EXPECT_DOUBLE_EQ(restart_delay(a, 4), 3.0) << "capped";
+  EXPECT_DOUBLE_EQ(restart_delay(a, 1000), 3.0);
+  // A first delay beyond the default cap raises the cap to it: it never waits less than asked.
+  EXPECT_DOUBLE_EQ(restart_delay(set.processes[1], 1), 40.0);
+  EXPECT_DOUBLE_EQ(restart_delay(set.processes[1], 5), 40.0);
+  EXPECT_NE(error_of("name: x\nprocesses:\n  - name: a\n    command: [x]\n    restart_delay: 2\n"
+                     "    restart_delay_max: 1\n")
+                .find("restart_delay_max"),
+            std::string::npos);
+}
+
 TEST(LaunchSet, SubstituteHandlesEdges) {
   EXPECT_EQ(substitute("a${x}b${x}", {{"x", "1"}}), "a1b1");
   EXPECT_EQ(substitute("plain", {}), "plain");

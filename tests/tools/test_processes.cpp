@@ -8,9 +8,11 @@
 #include <semx/node_status_t.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <regex>
 #include <set>
@@ -225,6 +227,81 @@ TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
   for (pid_t pid : started_pids(text)) EXPECT_FALSE(pid_alive(pid));
 }
 
+// Each restart is told its count (SEMX_RESTART, 0 at the first start) and waits twice as long as
+// the one before (procman's backoff), until the set's failure rule takes over.
+TEST(Processes, RestartsCountAndBackOff) {
+  const std::string set = temp_path("backoff.yaml");
+  std::ofstream(set) << "name: backoff\nprocesses:\n"
+                        "  - name: crashy\n    command: [/bin/sh, -c, \"echo run=$SEMX_RESTART; exit 3\"]\n"
+                        "    restart: on-failure\n    max_restarts: 3\n    restart_delay: 0.1\n";
+  const std::string out = temp_path("backoff.out");
+  Process launcher({bin("semx-launch"), set, "--no-color"}, out);
+  EXPECT_EQ(launcher.wait(20), 1);
+  const std::string text = read_file(out);
+  for (const char* line : {"crashy | run=0", "crashy | run=1", "crashy | run=2", "crashy | run=3",
+                           "restart 1/3 in 0.10 s", "restart 2/3 in 0.20 s", "restart 3/3 in 0.40 s",
+                           "required process failed"}) {
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
+  }
+}
+
+// A lockstep node killed with SIGKILL is brought back: the clock does not go on without it, it
+// reports its restart in NODE_STATUS, and the clock goes on once it acks again.
+TEST(Processes, AKilledLockstepNodeIsRespawnedAndTheClockWaitsForIt) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(9));
+  const std::string set = temp_path("respawn.yaml");
+  std::ofstream(set) << "name: respawn\nprocesses:\n"
+                        "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+                        "    restart: on-failure\n    restart_delay: 1.0\n"
+                        "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
+                        "--max-speed, \"2\"]\n    start_delay: 0.5\n";
+  const std::string out = temp_path("respawn.out");
+  const std::string key = temp_path("respawn.key");
+  std::filesystem::remove(key);
+  Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--key-out", key}, out);
+  // The set's key, to hear its messages.
+  for (int i = 0; i < 200 && !std::filesystem::exists(key); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  semx::runtime::NodeOptions o;
+  o.name = "respawn-test";
+  o.lcm_url = url;
+  o.auth_key_file = key;
+  o.follow_clock = false;
+  o.quiet = true;
+  semx::runtime::Node node(o);
+  int64_t tick = -1;
+  std::map<int32_t, int32_t> monitor_pids;  // pid -> restarts it reported
+  node.subscribe<semx::clock_t>("SIM_CLOCK", [&](const semx::clock_t& c) { tick = std::max(tick, c.tick); });
+  node.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t& s) {
+    if (s.node == "monitor") monitor_pids[s.pid] = s.restarts;
+  });
+  auto spin_for = [&](double s, const std::function<bool()>& done = nullptr) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+    while (std::chrono::steady_clock::now() < end && !(done && done())) node.spin_once(10);
+  };
+  spin_for(20, [&] { return tick >= 200; });
+  ASSERT_GE(tick, 200) << read_file(out);
+  ASSERT_EQ(monitor_pids.size(), 1u);
+  EXPECT_EQ(monitor_pids.begin()->second, 0) << "the first run is no restart";
+  const auto pids = started_pids(read_file(out));
+  ASSERT_FALSE(pids.empty());
+  kill(pids.front(), SIGKILL);  // the monitor: started first
+  spin_for(0.2);
+  const int64_t stalled = tick;
+  spin_for(0.6);
+  EXPECT_EQ(tick, stalled) << "the clock must wait for the dead node, not go on without it";
+  spin_for(20, [&] { return monitor_pids.size() == 2 && tick > stalled + 100; });
+  EXPECT_GT(tick, stalled + 100) << "the clock goes on with the respawned node\n" << read_file(out);
+  ASSERT_EQ(monitor_pids.size(), 2u) << read_file(out);
+  EXPECT_EQ(monitor_pids.rbegin()->first == pids.front() ? monitor_pids.begin()->second
+                                                          : monitor_pids.rbegin()->second,
+            1)
+      << "the new process reports its restart";
+  EXPECT_NE(read_file(out).find("monitor: restarted (pid"), std::string::npos) << read_file(out);
+  launcher.signal(SIGINT);
+  EXPECT_EQ(launcher.wait(15), 130) << read_file(out);
+}
+
 TEST(Processes, HiddenOutputGoesToTheLogAndShowsWhenItFails) {
   const std::string dir = temp_path("launch-logs");
   const std::string set = temp_path("hidden.yaml");
@@ -361,6 +438,7 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   const std::string url = semx::runtime::udpm_url_for_port(test_port(5));
   const std::string semx_cmd = std::string(SEMX_SOURCE_DIR) + "/semx";
   const std::string log = temp_path("recorded.lcmlog");
+  std::filesystem::remove(log);
   semx::runtime::NodeOptions o;
   o.name = "talker";
   o.lcm_url = url;

@@ -61,9 +61,6 @@ wait_for 30 master_up || { say "roscore did not come up"; exit 1; }
 # and the set shares the port the bridge already listens on (by default it would move away).
 key_file=$out/session.key
 (umask 077; od -An -tx1 -N32 /dev/urandom | tr -d ' \n' >"$key_file"; echo >>"$key_file")
-cat >"$out/original_mapper.yaml" <<YAML
-checkpoint: {path: $out/original.ckpt, period: 86400}
-YAML
 SEMX_AUTH_KEY_FILE=$key_file "$BIN/semx-ros-bridge" --lcm-url "$url_a" >"$out/logs/bridge_mirror.log" 2>&1 &
 bridge=$!
 pids+=($bridge)
@@ -77,12 +74,14 @@ wait_for 30 subscribed /semx/camera/depth/image_raw || { say "rosbag record did 
 sleep 1  # the bridge sees the subscriber within 0.2 s and converts images from then on
 say "recording a $time_limit s $world run (real time) to $out/sensors.bag"
 "$BIN/semx-launch" demo --lcm-url "$url_a" --auth-key "$key_file" --port-policy share --no-color --arg "world=$world" --arg clock=realtime \
-  --arg "time_limit=$time_limit" --arg "out=$out/original" --arg "mapper_config=$out/original_mapper.yaml" \
+  --arg "time_limit=$time_limit" --arg "out=$out/original" \
   >"$out/logs/demo.log" 2>&1 || { say "the simulated run failed (logs in $out/original/logs)"; tail -20 "$out/logs/demo.log"; exit 1; }
 sleep 2
 kill -INT "$recorder"; wait "$recorder" || true
 kill -INT "$bridge"; wait "$bridge" || true
-[ -f "$out/original.ckpt" ] || { say "the original run wrote no checkpoint"; exit 1; }
+# The demo set's mapper checkpoints into the run folder (where a restarted mapper resumes from).
+original_ckpt=$out/original/state/mapper.ckpt
+[ -f "$original_ckpt" ] || { say "the original run wrote no checkpoint ($original_ckpt)"; exit 1; }
 rosbag info "$out/sensors.bag" >"$out/bag_info.txt"
 grep -E "^(duration|messages)|image_raw|odom|tf" "$out/bag_info.txt" | sed 's/^/  /'
 
@@ -101,4 +100,4 @@ kill -INT "$external"; wait "$external" || true
 grep -h "semx-ros-bridge: published" "$out/external_logs/bridge.log" | sed 's/^/  /' || true
 
 # 3. The maps.
-"$BIN/semx-map-compare" "$out/original.ckpt" "$out/replayed.ckpt" --min "$min" | tee "$out/agreement.txt"
+"$BIN/semx-map-compare" "$original_ckpt" "$out/replayed.ckpt" --min "$min" | tee "$out/agreement.txt"

@@ -1,5 +1,6 @@
 #include "semx/tools/launch_set.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -71,6 +72,17 @@ LaunchSet load_launch_set(const std::string& file, const std::map<std::string, s
     root.fail("log_dir", e.what());
   }
 
+  std::vector<std::string> dirs;
+  root.get("dirs", dirs);
+  for (const auto& d : dirs) {
+    try {
+      const std::string dir = substitute(d, vars);
+      if (!dir.empty()) set.dirs.push_back(dir);
+    } catch (const std::exception& e) {
+      root.fail("dirs", e.what());
+    }
+  }
+
   for (ConfigMap& p : root.children("processes")) {
     ProcessSpec spec;
     p.get("name", spec.name);
@@ -98,6 +110,8 @@ LaunchSet load_launch_set(const std::string& file, const std::map<std::string, s
                                              : RestartPolicy::kNever;
     p.get("max_restarts", spec.max_restarts, 0, 1000);
     p.get("restart_delay", spec.restart_delay_s, 0.0, 600.0);
+    spec.restart_delay_max_s = std::max(spec.restart_delay_max_s, spec.restart_delay_s);
+    p.get("restart_delay_max", spec.restart_delay_max_s, spec.restart_delay_s, 3600.0);
     p.get("required", spec.required);
     p.get("ends_set", spec.ends_set);
     p.get("start_delay", spec.start_delay_s, 0.0, 600.0);
@@ -130,6 +144,12 @@ ExitAction on_process_exit(const ProcessSpec& spec, int exit_code, int restarts,
   if (spec.restart == RestartPolicy::kOnFailure && failed && may_restart) return ExitAction::kRestart;
   if (failed) return spec.required ? ExitAction::kFailSet : ExitAction::kContinue;
   return spec.ends_set ? ExitAction::kEndSet : ExitAction::kContinue;
+}
+
+double restart_delay(const ProcessSpec& spec, int in_a_row) {
+  double d = spec.restart_delay_s;
+  for (int i = 1; i < in_a_row && d < spec.restart_delay_max_s; ++i) d *= 2;
+  return std::min(d, spec.restart_delay_max_s);
 }
 
 }  // namespace semx::tools

@@ -12,7 +12,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "semx/runtime/log_scan.hpp"
 #include "semx/runtime/node_flags.hpp"
+#include "semx/runtime/restart_count.hpp"
 #include "semx/tools/channel_selection.hpp"
 
 using namespace semx::runtime;
@@ -50,10 +52,28 @@ int main(int argc, char** argv) {
       }
     }();
     std::error_code ec;
-    if (!force && std::filesystem::exists(file, ec))
+    // Restarted by the launcher after a crash: the run's log goes on, it is not begun again. A
+    // last event the crash cut short is cut off first, so the log stays readable end to end.
+    int64_t events = 0;
+    const char* mode = "w";
+    if (restart_count() > 0 && std::filesystem::exists(file, ec)) {
+      try {
+        const LogLayout layout = scan_log(file);
+        if (layout.truncated) std::filesystem::resize_file(file, layout.truncated_at);
+        events = layout.events;
+        mode = "a";
+        std::cerr << "semx-logger: restart " << restart_count() << ": appending to " << file << " after its "
+                  << events << " events" << (layout.truncated ? " (a last event cut short was removed)" : "")
+                  << "\n";
+      } catch (const LogError& e) {
+        // Nothing readable was written before the crash (an empty file): begin it.
+        std::cerr << "semx-logger: restart " << restart_count() << ": " << e.what() << "; writing it anew\n";
+      }
+    } else if (!force && std::filesystem::exists(file, ec)) {
       throw ArgError(file + ": exists (--force overwrites it)");
+    }
 
-    lcm_eventlog_t* log = lcm_eventlog_create(file.c_str(), "w");
+    lcm_eventlog_t* log = lcm_eventlog_create(file.c_str(), mode);
     if (!log) throw std::runtime_error(file + ": cannot open for writing");
     auto options = flags.options();
     options.follow_clock = false;  // a recorder keeps no time of its own
@@ -61,7 +81,7 @@ int main(int argc, char** argv) {
     options.observer = true;
     Node node(options);
     install_shutdown_handlers();
-    int64_t events = 0, failed = 0;
+    int64_t failed = 0;
     node.subscribe_raw(".*", [&](const std::string& ch, const uint8_t* data, std::size_t size) {
       if (!selection.wants(ch)) return;
       lcm_eventlog_event_t ev{};

@@ -56,13 +56,13 @@ std::vector<std::string> StatusBoard::missing(const std::vector<std::string>& na
 std::string StatusBoard::render_nodes(double wall_s) const {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-16s %7s %-9s %9s %9s %9s %6s %6s %6s %7s %5s  %s\n", "NODE", "PID",
-                "STATE", "SIM_T[s]", "RECV", "SENT", "DROP", "BAD", "CPU%", "RSS[MB]", "AGE", "DETAIL");
+  std::snprintf(line, sizeof line, "%-16s %7s %3s %-9s %9s %9s %9s %6s %6s %6s %7s %5s  %s\n", "NODE", "PID",
+                "RST", "STATE", "SIM_T[s]", "RECV", "SENT", "DROP", "BAD", "CPU%", "RSS[MB]", "AGE", "DETAIL");
   out += line;
   for (const auto& [name, row] : nodes_) {
     const auto& s = row.status;
-    std::snprintf(line, sizeof line, "%-16s %7d %-9s %9.2f %9lld %9lld %6lld %6lld %6.1f %7.1f %5.1f  %s\n",
-                  name.c_str(), s.pid, state_name(s.state), static_cast<double>(s.utime) * 1e-6,
+    std::snprintf(line, sizeof line, "%-16s %7d %3d %-9s %9.2f %9lld %9lld %6lld %6lld %6.1f %7.1f %5.1f  %s\n",
+                  name.c_str(), s.pid, s.restarts, state_name(s.state), static_cast<double>(s.utime) * 1e-6,
                   static_cast<long long>(s.received), static_cast<long long>(s.sent),
                   static_cast<long long>(s.dropped), static_cast<long long>(s.malformed), row.cpu_percent,
                   static_cast<double>(s.rss_kb) / 1024.0, wall_s - row.last_seen_s, s.detail.c_str());

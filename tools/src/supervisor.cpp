@@ -10,6 +10,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "semx/runtime/config.hpp"
+#include "semx/runtime/restart_count.hpp"
 
 namespace semx::tools {
 
@@ -43,7 +45,9 @@ struct Child {
   int out_fd = -1;
   std::string partial;
   int restarts = 0;
-  double start_at = 0;  // when to (re)start, if pid < 0 and pending
+  int in_a_row = 0;       // restarts since the last run that outlasted the backoff's cap
+  double started_at = 0;  // when the running process was started
+  double start_at = 0;    // when to (re)start, if pid < 0 and pending
   bool pending = true;
   bool finished = false;
   const char* color = "";
@@ -79,6 +83,11 @@ class Supervisor {
       std::error_code ec;
       std::filesystem::create_directories(log_dir, ec);
       if (ec) throw std::runtime_error("log directory '" + log_dir + "': " + ec.message());
+    }
+    for (const auto& d : set.dirs) {
+      std::error_code ec;
+      std::filesystem::create_directories(d, ec);
+      if (ec) throw std::runtime_error("directory '" + d + "': " + ec.message());
     }
     for (const auto& p : set.processes) {
       Child c;
@@ -239,6 +248,7 @@ class Supervisor {
       if (!log_dir_.empty()) {
         setenv(runtime::kEffectiveConfigEnv, (log_dir_ + "/" + c.spec->name + ".config.yaml").c_str(), 1);
       }
+      setenv(runtime::kRestartEnv, std::to_string(c.restarts).c_str(), 1);
       for (const auto& [k, v] : c.spec->env) setenv(k.c_str(), v.c_str(), 1);
       std::vector<char*> argv;
       for (auto& a : argv_s) argv.push_back(a.data());
@@ -252,7 +262,8 @@ class Supervisor {
     fcntl(fds[0], F_SETFL, O_NONBLOCK);
     c.pid = pid;
     c.out_fd = fds[0];
-    say(c, "started (pid " + std::to_string(pid) + "): " + join(argv_s));
+    c.started_at = now_s();
+    say(c, (c.restarts > 0 ? "restarted (pid " : "started (pid ") + std::to_string(pid) + "): " + join(argv_s));
   }
 
   static std::string join(const std::vector<std::string>& v) {
@@ -278,7 +289,8 @@ class Supervisor {
             say(std::string("caught ") + (sig[i] == SIGINT ? "SIGINT" : "SIGTERM") +
                 ": stopping all processes");
             begin_stop(130);
-          } else if (!killed_) {
+            signalled_at_ = now_s();
+          } else if (!killed_ && (signalled_at_ < 0 || now_s() - signalled_at_ > kSameSignalS)) {
             say("second signal: SIGKILL now");
             kill_at_ = 0;
           }
@@ -306,14 +318,20 @@ class Supervisor {
         const ExitAction action = on_process_exit(*c.spec, code, c.restarts, stopping_);
         if (code != 0 && !stopping_) show_recent(c);
         switch (action) {
-          case ExitAction::kRestart:
+          case ExitAction::kRestart: {
             ++c.restarts;
+            const double t = now_s();
+            // A process that ran for a while was healthy: its next failure starts the backoff over.
+            c.in_a_row = t - c.started_at > c.spec->restart_delay_max_s ? 1 : c.in_a_row + 1;
+            const double delay = restart_delay(*c.spec, c.in_a_row);
+            char when[32];
+            std::snprintf(when, sizeof when, "%.2f", delay);
             say(c, how + ": restart " + std::to_string(c.restarts) + "/" +
-                       std::to_string(c.spec->max_restarts) + " in " +
-                       std::to_string(c.spec->restart_delay_s) + " s");
+                       std::to_string(c.spec->max_restarts) + " in " + when + " s");
             c.pending = true;
-            c.start_at = now_s() + c.spec->restart_delay_s;
+            c.start_at = t + delay;
             break;
+          }
           case ExitAction::kFailSet:
             say(c, how + ": required process failed, stopping the set");
             begin_stop(1);
@@ -357,6 +375,10 @@ class Supervisor {
   std::string log_dir_;  // the set's log_dir (or --log-dir): where processes write their logs and configs
   bool stopping_ = false;
   bool killed_ = false;
+  // A Ctrl-C reaches both a wrapper script and the launcher, and the script passes it on: a signal
+  // this soon after the first is that one again, not a second Ctrl-C.
+  static constexpr double kSameSignalS = 0.5;
+  double signalled_at_ = -1;
   double kill_at_ = 0;
   int exit_code_ = 0;
 };

@@ -4,6 +4,7 @@
 
 #include "evaluator_node.hpp"
 #include "semx/runtime/node_flags.hpp"
+#include "semx/runtime/restart_count.hpp"
 #include "semx/simulator/world.hpp"
 
 using namespace semx;
@@ -11,7 +12,7 @@ using namespace semx;
 int main(int argc, char** argv) {
   return runtime::run_main("semx-evaluator", [&] {
     runtime::NodeFlags flags("evaluator");
-    std::string world = "env1", out, planner;
+    std::string world = "env1", out, planner, state;
     int64_t seed = -1, samples = -1;
     double time_limit = 0, progress = 10, resolution = 0.1, sample_period = 1.0;
     runtime::ArgParser p(
@@ -34,7 +35,11 @@ int main(int argc, char** argv) {
                 "(default 0.1; the map's own resolution wins)",
                 &resolution)
         .option("sample-period", "S", "simulated seconds between coverage samples (default 1)",
-                &sample_period);
+                &sample_period)
+        .option("state", "FILE",
+                "journal of the run's state, appended every coverage sample; restarted by the launcher "
+                "(SEMX_RESTART > 0), go on from it",
+                &state);
     if (!p.parse(argc, argv)) return 0;
     if (time_limit < 0) throw runtime::ArgError("--time-limit must not be negative");
     if (progress < 0) throw runtime::ArgError("--progress must not be negative");
@@ -56,6 +61,8 @@ int main(int argc, char** argv) {
     o.evaluation.metrics.sample_period_s = sample_period;
     o.out_dir = out;
     o.progress_s = progress;
+    o.state_path = state;
+    o.resume = !state.empty() && runtime::restart_count() > 0;
 
     runtime::Node node(flags.options());
     runtime::install_shutdown_handlers();
@@ -64,6 +71,11 @@ int main(int argc, char** argv) {
               << "), |T| = " << ev.evaluation().tracker().target_count() << " voxels at "
               << ev.evaluation().tracker().resolution() << " m, on " << node.url()
               << (flags.lockstep ? " (lockstep)" : "") << std::endl;
+    if (o.resume) {
+      std::cout << "semx-evaluator: restart " << runtime::restart_count() << ": resumed " << ev.restored_records()
+                << " records of " << state << " (t=" << ev.evaluation().metrics().now_utime() * 1e-6 << " s)"
+                << std::endl;
+    }
     return ev.run();
   });
 }

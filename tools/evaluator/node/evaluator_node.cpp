@@ -31,6 +31,12 @@ double wall_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+double epoch_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+constexpr uint32_t kStateKind = runtime::state_kind("EVAL");
+
 map::MapClientOptions client_options(const runtime::Node& node) {
   map::MapClientOptions o;
   o.resolution = 0;  // adopt the mapper's; the ground truth follows it
@@ -120,20 +126,83 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
     }
     regions_ = std::move(regions);
   });
+  // Who of the set restarted, and when (a disturbed run is marked so in metrics.json), and each
+  // node's messages lost for good.
   node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& m) {
     // A recorder's or viewer's losses leave its log or picture short, not the run.
     if (m.lost > 0 && !m.observer) lost_[m.node] = std::max(lost_[m.node], m.lost);
+    const int64_t t = std::max(node_.now_utime(), evaluation_.metrics().now_utime());
+    const size_t before = evaluation_.restarts().size();
+    evaluation_.on_node_status(m.node, m.pid, m.restarts, t);
+    if (options_.print && evaluation_.restarts().size() > before) {
+      const NodeRestart& r = evaluation_.restarts().back();
+      std::printf("semx-evaluator: %s restarted (restart %d) at t=%.2f s: the run is marked disturbed\n",
+                  r.node.c_str(), r.restarts, r.t_s);
+      std::fflush(stdout);
+    }
   });
   node_.on_tick([this](int64_t tick, int64_t utime) { on_tick(tick, utime); });
   // It publishes nothing but its map client's requests: with the mirror in sync the clock need
   // not wait for it (it ends the set from message time, wherever the clock is by then).
   node_.on_quiet_until(
       [this](int64_t utime) { return map_.in_sync() ? std::numeric_limits<int64_t>::max() : utime; });
+  open_state();
   node_.set_state(runtime::NodeState::kRunning, "waiting for the simulation");
 }
 
+void EvaluatorNode::open_state() {
+  if (options_.state_path.empty()) return;
+  uint64_t valid = 0;
+  if (options_.resume) {
+    const auto records = runtime::read_state_journal(options_.state_path, kStateKind, &valid);
+    for (size_t i = 0; i < records.size(); ++i) {
+      const auto& rec = records[i];
+      core::ByteReader r(rec.data(), rec.size());
+      try {
+        const double epoch = r.f64();
+        next_progress_s_ = r.f64();
+        evaluation_.restore(r);
+        if (epoch > 0) wall_start_epoch_ = epoch;
+      } catch (const std::exception& e) {
+        throw runtime::StateFileError(options_.state_path + ": record " + std::to_string(i + 1) + ": " + e.what());
+      }
+    }
+    restored_records_ = records.size();
+    if (wall_start_epoch_ > 0) wall_start_ = wall_now() - (epoch_now() - wall_start_epoch_);
+    saved_samples_ = evaluation_.metrics().samples().size();
+  }
+  journal_ = std::make_unique<runtime::StateJournal>(options_.state_path, kStateKind, !options_.resume);
+  // A record cut short by the crash is dropped; the next one follows the last whole one.
+  if (options_.resume) journal_->truncate(valid);
+  saved_ = evaluation_.metrics().sizes();
+  if (options_.resume) {
+    // This evaluator is itself a restart: the run is disturbed even if it never hears its own
+    // status.
+    const auto self = node_.status();
+    evaluation_.on_node_status(self.node, self.pid, self.restarts, evaluation_.metrics().now_utime());
+  }
+}
+
+void EvaluatorNode::save_state() {
+  if (!journal_) return;
+  std::vector<uint8_t> bytes;
+  core::ByteWriter w(bytes);
+  w.f64(wall_start_epoch_);
+  w.f64(next_progress_s_);
+  evaluation_.save(w, saved_);
+  try {
+    journal_->append(bytes);
+  } catch (const runtime::StateFileError& e) {
+    std::cerr << "semx-evaluator: " << e.what() << " (the run goes on without saving its state)\n";
+    journal_.reset();
+  }
+}
+
 void EvaluatorNode::note_wall() {
-  if (wall_start_ < 0) wall_start_ = wall_now();
+  if (wall_start_ < 0) {
+    wall_start_ = wall_now();
+    wall_start_epoch_ = epoch_now();
+  }
 }
 
 double EvaluatorNode::wall_s() const {
@@ -147,6 +216,11 @@ void EvaluatorNode::on_tick(int64_t /*tick*/, int64_t utime) {
   if (finished()) return;
   evaluation_.advance(utime);
   progress(utime);
+  // A record per coverage sample: what a crash loses is at most one sample period.
+  if (evaluation_.metrics().samples().size() != saved_samples_) {
+    saved_samples_ = evaluation_.metrics().samples().size();
+    save_state();
+  }
 }
 
 void EvaluatorNode::message_time(int64_t utime) {

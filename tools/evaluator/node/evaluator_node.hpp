@@ -20,6 +20,7 @@
 #include "semx/evaluator/evaluation.hpp"
 #include "semx/evaluator/run_overlays.hpp"
 #include "semx/runtime/node.hpp"
+#include "semx/runtime/state_file.hpp"
 
 namespace semx::evaluator {
 
@@ -28,6 +29,12 @@ struct EvaluatorNodeOptions {
   std::string out_dir;     // run folder; "" writes nothing
   double progress_s = 10;  // simulated seconds between progress lines; 0: none
   bool print = true;       // progress lines and the final table on stdout
+  // A journal of the run's state, appended every coverage sample (empty: none), and whether to
+  // go on from what it holds (a restart after a crash): the series, distance, collisions and
+  // timestamps come back from it, the map from the mapper's snapshot (docs/launch.md, "When a
+  // process dies").
+  std::string state_path;
+  bool resume = false;
 };
 
 class EvaluatorNode {
@@ -50,6 +57,8 @@ class EvaluatorNode {
   const map::MapClient& map() const { return map_; }
   const std::vector<std::string>& written() const { return written_; }
   bool write_failed() const { return write_failed_; }
+  // Journal records restored at start (0: a fresh run).
+  size_t restored_records() const { return restored_records_; }
 
  private:
   void on_tick(int64_t tick, int64_t utime);
@@ -61,6 +70,8 @@ class EvaluatorNode {
   double wall_s() const;
   void finish_at(Termination why, int64_t utime);
   void write_folder();
+  void open_state();
+  void save_state();
 
   runtime::Node& node_;
   EvaluatorNodeOptions options_;
@@ -77,6 +88,11 @@ class EvaluatorNode {
   // any were is not the seed's run.
   std::map<std::string, int64_t> lost_;
   void check_validity();
+  std::unique_ptr<runtime::StateJournal> journal_;
+  Evaluation::Saved saved_;
+  size_t saved_samples_ = 0;
+  size_t restored_records_ = 0;
+  double wall_start_epoch_ = -1;  // system clock at wall_start_, which a restart keeps counting from
 };
 
 }  // namespace semx::evaluator

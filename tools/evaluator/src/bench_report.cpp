@@ -224,6 +224,13 @@ BenchRun load_bench_run(const std::string& dir) {
   if (m["end_game_s"] && !m["end_game_s"].IsNull()) r.end_game_s = number_of(m, "end_game_s", file);
   if (m["object_coverage_pct"] && !m["object_coverage_pct"].IsNull())
     r.object_coverage_pct = number_of(m, "object_coverage_pct", file);
+  r.disturbed = m["disturbed"] && m["disturbed"].IsScalar() && m["disturbed"].as<std::string>() == "true";
+  if (m["restarts"] && m["restarts"].IsSequence()) {
+    for (const auto& x : m["restarts"]) {
+      if (!x.IsMap() || !x["node"] || !x["t_s"]) continue;
+      r.restarts += (r.restarts.empty() ? "" : ", ") + x["node"].as<std::string>() + " " + x["t_s"].as<std::string>() + " s";
+    }
+  }
 
   const std::string split_file = (fs::path(dir) / "time_split.json").string();
   if (fs::exists(split_file)) {
@@ -289,25 +296,40 @@ void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptio
   }
 }
 
-static std::vector<BenchRun> valid_only(const std::vector<BenchRun>& runs) {
+// The runs the tables summarise: valid (no message lost or mixed) and undisturbed (no process
+// restarted during the run).
+static std::vector<BenchRun> tabled_only(const std::vector<BenchRun>& runs) {
   std::vector<BenchRun> out;
   for (const auto& r : runs)
-    if (r.valid) out.push_back(r);
+    if (r.valid && !r.disturbed) out.push_back(r);
   return out;
 }
 
 static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o);
 
 std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOptions& o) {
-  std::string md = tables_markdown(valid_only(all), o);
+  std::string md = tables_markdown(tabled_only(all), o);
   std::string left_out;
   for (const auto& r : all) {
-    if (r.valid) continue;
+    if (r.valid || r.disturbed) continue;  // a disturbed run is listed with the disturbed ones
     left_out += "- " + r.dir + " (" + r.world + ", " + r.planner + ", seed " + std::to_string(r.seed) + "): " +
                 r.invalid_reason + "\n";
   }
   if (!left_out.empty()) {
     md += "\n### Runs left out of the tables (not valid: lost or mixed messages)\n\n" + left_out;
+  }
+  std::ostringstream d;
+  for (const auto& r : all) {
+    if (!r.disturbed) continue;
+    d << "| " << r.world << " | " << r.planner << " | " << r.samples << " | " << r.seed << " | "
+      << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | " << fmt(r.coverage_pct, 2)
+      << " | " << r.termination << " | " << (r.valid ? "" : r.invalid_reason) << " | " << r.dir << " |\n";
+  }
+  if (!d.str().empty()) {
+    md += "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
+          "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
+          "termination | not valid | folder |\n|---|---|---|---|---|---|---|---|---|---|\n" +
+          d.str();
   }
   return md;
 }
@@ -505,7 +527,7 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
 std::string bench_csv(const std::vector<BenchRun>& runs) {
   std::ostringstream c;
   c << "world,planner,seed,samples,time_f_s,distance_m,coverage_pct,time_r_s,collisions,wall_s,sim_s,"
-       "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s\n";
+       "termination,dir,object_coverage_pct,time_o_s,time_95_s,time_settled_s,end_game_s,disturbed\n";
   for (const auto& r : runs) {
     c << csv_escape(r.world) << ',' << csv_escape(r.planner) << ',' << r.seed << ',' << r.samples << ','
       << fmt(r.time_f_s, 3) << ',' << fmt(r.distance_m, 3) << ',' << fmt(r.coverage_pct, 3) << ','
@@ -515,14 +537,15 @@ std::string bench_csv(const std::vector<BenchRun>& runs) {
       << (r.time_o_s ? fmt(*r.time_o_s, 3) : std::string()) << ','
       << (r.time_95_s ? fmt(*r.time_95_s, 3) : std::string()) << ','
       << (r.time_settled_s ? fmt(*r.time_settled_s, 3) : std::string()) << ','
-      << (r.end_game_s ? fmt(*r.end_game_s, 3) : std::string()) << '\n';
+      << (r.end_game_s ? fmt(*r.end_game_s, 3) : std::string()) << ',' << (r.disturbed ? "true" : "false")
+      << '\n';
   }
   return c.str();
 }
 
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, const std::string& dir,
                                            const BenchReportOptions& o) {
-  const std::vector<BenchRun> runs = valid_only(all);
+  const std::vector<BenchRun> runs = tabled_only(all);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
     std::vector<const BenchRun*> here;

@@ -80,6 +80,16 @@ void Evaluation::on_episode_end(int64_t utime, double wall_s) {
   finish(Termination::kEpisodeEnd, utime, wall_s);
 }
 
+void Evaluation::on_node_status(const std::string& node, int pid, int restarts, int64_t utime) {
+  if (finished()) return;
+  const auto it = nodes_.find(node);
+  const bool first = it == nodes_.end();
+  const bool again = first ? restarts > 0 : restarts > it->second.restarts ||
+                                                (restarts == it->second.restarts && pid != it->second.pid);
+  if (again) restarts_.push_back({node, static_cast<double>(utime) * 1e-6, restarts});
+  nodes_[node] = {pid, restarts};
+}
+
 std::optional<Termination> Evaluation::due(int64_t utime) const {
   if (finished()) return std::nullopt;
   if (const auto done = metrics_.planner_done_utime(); done && utime > *done) {
@@ -139,12 +149,59 @@ RunSummary Evaluation::summary() const {
   s.covered_voxels = tracker_->covered();
   s.object_voxels = tracker_->object_target_count();
   s.map_seq = map_seq_;
+  s.restarts = restarts_;
   s.coverage = metrics_.samples();
   s.trajectory = metrics_.trajectory();
   const double res = tracker_->resolution();
   // A run whose coverage never settled (no map) has no end game.
   s.time_split = time_split_.finish(s.time_f_s, s.time_settled_s.value_or(s.time_f_s), res * res * res);
   return s;
+}
+
+void Evaluation::save(core::ByteWriter& w, Saved& saved) const {
+  metrics_.save(w, saved);
+  w.str(planner_);
+  w.str(planner_reason_);
+  w.i64(map_deltas_);
+  w.i64(map_resets_);
+  w.i64(map_seq_);
+  w.u32(static_cast<uint32_t>(nodes_.size()));
+  for (const auto& [name, n] : nodes_) {
+    w.str(name);
+    w.i32(n.pid);
+    w.i32(n.restarts);
+  }
+  w.u32(static_cast<uint32_t>(restarts_.size()));
+  for (const auto& r : restarts_) {
+    w.str(r.node);
+    w.f64(r.t_s);
+    w.i32(r.restarts);
+  }
+}
+
+void Evaluation::restore(core::ByteReader& r) {
+  metrics_.restore(r);
+  planner_ = r.str();
+  planner_reason_ = r.str();
+  map_deltas_ = r.i64();
+  map_resets_ = r.i64();
+  map_seq_ = r.i64();
+  nodes_.clear();
+  for (uint32_t i = 0, n = r.u32(); i < n; ++i) {
+    std::string name = r.str();
+    NodeSeen seen;
+    seen.pid = r.i32();
+    seen.restarts = r.i32();
+    nodes_[std::move(name)] = seen;
+  }
+  restarts_.clear();
+  for (uint32_t i = 0, n = r.u32(); i < n; ++i) {
+    NodeRestart x;
+    x.node = r.str();
+    x.t_s = r.f64();
+    x.restarts = r.i32();
+    restarts_.push_back(std::move(x));
+  }
 }
 
 }  // namespace semx::evaluator

@@ -128,6 +128,15 @@ std::string metrics_json(const RunSummary& s) {
   field("object_voxels", std::to_string(s.object_voxels));
   field("map_seq", std::to_string(s.map_seq));
   field("coverage_samples", std::to_string(s.coverage.size()));
+  // A process of the set died and was restarted: the figures are not an undisturbed run's.
+  field("disturbed", s.restarts.empty() ? "false" : "true");
+  std::string restarts = "[";
+  for (size_t i = 0; i < s.restarts.size(); ++i) {
+    const NodeRestart& r = s.restarts[i];
+    restarts += std::string(i ? ", " : "") + "{\"node\": " + json_string(r.node) + ", \"t_s\": " + number(r.t_s) +
+                ", \"restarts\": " + std::to_string(r.restarts) + "}";
+  }
+  field("restarts", restarts + "]");
   field("source", json_string(s.info.source), true);
   o << "}\n";
   return o.str();

@@ -1,6 +1,8 @@
 #include "semx/evaluator/run_metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace semx::evaluator {
 
@@ -179,6 +181,117 @@ std::optional<double> RunMetrics::planner_done_s() const {
 std::optional<Eigen::Vector3d> RunMetrics::position() const {
   if (!have_odometry_) return std::nullopt;
   return last_position_;
+}
+
+namespace {
+
+void put_opt(core::ByteWriter& w, const std::optional<int64_t>& v) {
+  w.u8(v ? 1 : 0);
+  w.i64(v.value_or(0));
+}
+
+std::optional<int64_t> get_opt(core::ByteReader& r) {
+  const bool has = r.u8() != 0;
+  const int64_t v = r.i64();
+  return has ? std::optional<int64_t>(v) : std::nullopt;
+}
+
+void put_vec(core::ByteWriter& w, const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) w.f64(v[i]);
+}
+
+Eigen::Vector3d get_vec(core::ByteReader& r) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = r.f64();
+  return v;
+}
+
+// The series from the element before `saved` (it may have been replaced since) to the end.
+template <class T, class Put>
+void put_tail(core::ByteWriter& w, const std::vector<T>& v, size_t& saved, Put put) {
+  const size_t from = std::min(saved, v.size()) > 0 ? std::min(saved, v.size()) - 1 : 0;
+  w.u64(from);
+  w.u64(v.size() - from);
+  for (size_t i = from; i < v.size(); ++i) put(v[i]);
+  saved = v.size();
+}
+
+template <class T, class Get>
+void get_tail(core::ByteReader& r, std::vector<T>& v, Get get) {
+  const uint64_t from = r.u64();
+  const uint64_t n = r.u64();
+  if (from > v.size()) throw std::runtime_error("evaluator state: a record is missing before this one");
+  if (n > r.remaining()) throw std::out_of_range("unexpected end of data");
+  v.resize(from);
+  for (uint64_t i = 0; i < n; ++i) v.push_back(get());
+}
+
+}  // namespace
+
+void RunMetrics::save(core::ByteWriter& w, Saved& saved) const {
+  w.i64(now_utime_);
+  w.u8(have_odometry_ ? 1 : 0);
+  w.i64(last_odometry_utime_);
+  put_vec(w, last_position_);
+  w.f64(distance_m_);
+  w.i64(covered_);
+  w.i64(target_);
+  put_opt(w, time_r_utime_);
+  put_opt(w, time_95_utime_);
+  w.i64(object_covered_);
+  w.i64(object_target_);
+  put_opt(w, time_o_utime_);
+  w.i64(collision_events_);
+  w.i64(collision_count_);
+  w.i32(static_cast<int32_t>(planner_state_));
+  put_opt(w, done_utime_);
+  w.i64(next_sample_utime_);
+  put_tail(w, trajectory_, saved.trajectory, [&](const Eigen::Vector3d& p) { put_vec(w, p); });
+  put_tail(w, samples_, saved.samples, [&](const CoverageSample& s) {
+    w.f64(s.t_s);
+    w.f64(s.coverage_pct);
+    w.f64(s.distance_m);
+    w.i64(s.covered);
+    w.f64(s.object_coverage_pct);
+  });
+  put_tail(w, growth_, saved.growth, [&](const std::pair<int64_t, int64_t>& g) {
+    w.i64(g.first);
+    w.i64(g.second);
+  });
+}
+
+void RunMetrics::restore(core::ByteReader& r) {
+  now_utime_ = r.i64();
+  have_odometry_ = r.u8() != 0;
+  last_odometry_utime_ = r.i64();
+  last_position_ = get_vec(r);
+  distance_m_ = r.f64();
+  covered_ = r.i64();
+  target_ = r.i64();
+  time_r_utime_ = get_opt(r);
+  time_95_utime_ = get_opt(r);
+  object_covered_ = r.i64();
+  object_target_ = r.i64();
+  time_o_utime_ = get_opt(r);
+  collision_events_ = r.i64();
+  collision_count_ = r.i64();
+  planner_state_ = planner_state_from_int(r.i32());
+  done_utime_ = get_opt(r);
+  next_sample_utime_ = r.i64();
+  get_tail(r, trajectory_, [&] { return get_vec(r); });
+  get_tail(r, samples_, [&] {
+    CoverageSample s;
+    s.t_s = r.f64();
+    s.coverage_pct = r.f64();
+    s.distance_m = r.f64();
+    s.covered = r.i64();
+    s.object_coverage_pct = r.f64();
+    return s;
+  });
+  get_tail(r, growth_, [&] {
+    const int64_t u = r.i64();
+    return std::pair<int64_t, int64_t>(u, r.i64());
+  });
 }
 
 }  // namespace semx::evaluator

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "semx/core/angles.hpp"
+#include "semx/core/byte_io.hpp"
 
 namespace semx::core {
 
@@ -38,6 +39,9 @@ class SplitMix64 {
     (void)next();
   }
   uint64_t next() { return splitmix64_mix(state_ += kGoldenGamma); }
+  // The exact state, for a process that saves it and resumes (state_file.hpp).
+  void save(ByteWriter& w) const { w.u64(state_); }
+  void restore(ByteReader& r) { state_ = r.u64(); }
 
  private:
   uint64_t state_ = 0;
@@ -67,6 +71,12 @@ class Xoshiro256StarStar {
     s_[2] ^= t;
     s_[3] = rotl(s_[3], 45);
     return result;
+  }
+  void save(ByteWriter& w) const {
+    for (uint64_t s : s_) w.u64(s);
+  }
+  void restore(ByteReader& r) {
+    for (uint64_t& s : s_) s = r.u64();
   }
 
  private:
@@ -119,6 +129,17 @@ class Random {
       p *= uniform();
     }
     return k;
+  }
+  // Every draw after restore() is the one the saved generator would have made next.
+  void save(ByteWriter& w) const {
+    engine_.save(w);
+    w.f64(spare_);
+    w.u8(has_spare_ ? 1 : 0);
+  }
+  void restore(ByteReader& r) {
+    engine_.restore(r);
+    spare_ = r.f64();
+    has_spare_ = r.u8() != 0;
   }
 
  private:

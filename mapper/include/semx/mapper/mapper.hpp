@@ -64,6 +64,13 @@ class Mapper {
   // Replaces the map with the checkpoint's (throws MapIoError, leaving the map as it was).
   CheckpointInfo load_checkpoint(const std::string& path);
 
+  // Replays a delta this mapper published after its last checkpoint (the node's journal): each
+  // changed voxel gets the log-odds of one observation of its new state (one hit for occupied,
+  // one miss for free), so the map's states are those the clients were sent, while the log-odds
+  // of those voxels are approximate (the rest are the checkpoint's, exact). The sequence is left
+  // as it is (a restore's jump). Throws MapIoError for a delta of another resolution.
+  void replay_delta(const map::MapDelta& delta);
+
   int64_t frames_integrated() const { return frames_integrated_; }
   int64_t frames_rejected() const { return frames_rejected_; }
   // Pixel outcomes summed over all accepted frames.

@@ -63,7 +63,10 @@ class ExplorationPlanner {
   // The world's ground truth, for the known-map oracle only (Strategy::set_truth; the other
   // planners ignore it). Must outlive the planner's use.
   void set_truth(const TruthMap* truth) { strategy_->set_truth(truth); }
-  void on_controller_status(ControllerState state, int64_t plan_id);
+  // `utime`: the status's message time (-1: unknown). A controller that reports no plan at all
+  // (IDLE or STALE_INPUT, plan 0) loop.lost_path_s after a path went out has lost it (it was
+  // restarted): the planner plans again from where the vehicle is.
+  void on_controller_status(ControllerState state, int64_t plan_id, int64_t utime = -1);
 
   struct Output {
     std::optional<PlannedPath> path;
@@ -131,6 +134,7 @@ class ExplorationPlanner {
   VoxelSet unobservable_;
   int64_t arrived_utime_ = -1;  // since when the vehicle is within tolerance of the goal
   int64_t short_since_ = -1;    // since when the controller holds away from the goal
+  int64_t released_utime_ = -1;  // when the goal's path went out
   core::SplitMixRng rng_;
   const map::StateGrid* grid_ = nullptr;
   std::optional<VehiclePose> pose_;

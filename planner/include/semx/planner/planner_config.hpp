@@ -208,6 +208,10 @@ struct LoopConfig {
   // goal before the goal is given up (and blacklisted): a vehicle that cannot get there (its
   // commands rejected, a body that does not fit) would otherwise wait for it forever.
   double short_hold_s = 3.0;
+  // s after a path went out: a controller that still reports no plan at all has lost it (it was
+  // restarted after a crash), and the planner plans again. In a run without a restart a
+  // controller never reports plan 0 once it has taken a path, so this changes nothing there.
+  double lost_path_s = 1.0;
   // Goals that do not deliver (docs/planner.md, "The end game"): the share of their gain that the
   // last this many goals delivered (voxels the map gained while each was flown, over the gain it
   // was chosen with; at most 1) scales every node's gain before min_gain is applied, so when the

@@ -50,6 +50,10 @@ class ClockServer {
   // (the clock's own node misses a message an ack named: Node::holds_everything) holds the next
   // tick back in LOCKSTEP, as a missing ack would.
   std::optional<ClockTick> poll(double wall_s, bool inputs_held = true);
+  // A clock source that was restarted continues at `tick` (the last one it published before it
+  // died; ticks never go backwards): the first poll() resends it, in LOCKSTEP until every node
+  // acked it again, and time goes on from there.
+  void resume(int64_t tick, double wall_s);
   // Records an ack (with its promise, 0 for none) received at wall time `wall_s` (< 0: unknown);
   // returns true if it completed the current tick's set.
   bool on_ack(const std::string& node, int64_t tick, int64_t quiet_until = 0, double wall_s = -1.0);

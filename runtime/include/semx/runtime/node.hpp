@@ -33,6 +33,7 @@
 #include "semx/runtime/delivery.hpp"
 #include "semx/runtime/lcm_schema.hpp"
 #include "semx/runtime/message_auth.hpp"
+#include "semx/runtime/restart_count.hpp"
 #include "semx/runtime/sim_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
 #include "semx/runtime/udpm_sender.hpp"
@@ -66,6 +67,8 @@ struct NodeOptions {
   // A process that watches a set and changes nothing of its run (recorder, monitor, viewer): its
   // lost messages make a log or a picture incomplete, not the run invalid (NODE_STATUS observer).
   bool observer = false;
+  // How often the launcher restarted this process (restart_count.hpp), reported in NODE_STATUS.
+  int restarts = restart_count();
 };
 
 struct ChannelCounters {

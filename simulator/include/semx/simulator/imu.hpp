@@ -32,6 +32,9 @@ class ImuModel {
   ImuModel(const ImuConfig& config, uint64_t seed);
   // A sample of the state; white noise has σ = density · √rate per sample.
   ImuSample sample(int64_t utime, const VehicleState& state);
+  // The generator and the biases, so a restored model draws what this one would have.
+  void save(core::ByteWriter& w) const;
+  void restore(core::ByteReader& r);
 
  private:
   ImuConfig config_;

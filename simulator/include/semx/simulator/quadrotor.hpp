@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/core/byte_io.hpp"
 #include "semx/runtime/config.hpp"
 #include "semx/simulator/world.hpp"
 
@@ -93,6 +94,11 @@ class Quadrotor {
   int64_t collisions() const { return collisions_; }
   int64_t blocked_steps() const { return blocked_steps_; }
   int64_t rejected_commands() const { return rejected_; }
+
+  // Everything that changes while it flies (state, command, contact, counters), bit for bit.
+  void save(core::ByteWriter& w) const;
+  // Throws std::out_of_range when the bytes run out.
+  void restore(core::ByteReader& r);
 
  private:
   const World& world_;

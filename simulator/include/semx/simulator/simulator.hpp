@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "semx/runtime/config.hpp"
 #include "semx/runtime/pinhole_camera.hpp"
@@ -95,6 +96,13 @@ class Simulator {
   Rasterizer& rasterizer() { return *rasterizer_; }
   int64_t camera_frames_due() const { return camera_count_; }
   int64_t command_timeouts() const { return timeouts_; }
+
+  // Everything step() changes (time, sensor counters, the vehicle, the IMU's generator and
+  // biases), so a simulator restarted after a crash continues the same episode: restored into a
+  // Simulator of the same world and config, it steps on exactly as this one would have.
+  std::vector<uint8_t> save_state() const;
+  // Throws std::runtime_error when the bytes are not a state of this world, seed and step.
+  void restore_state(const std::vector<uint8_t>& bytes);
 
  private:
   // Time of sample k of a sensor at `rate_hz`, rounded up to the step grid.

@@ -15,7 +15,10 @@ struct ProcessSpec {
   std::vector<std::string> command;  // argv after substitution; command[0] resolved later
   RestartPolicy restart = RestartPolicy::kNever;
   int max_restarts = 3;
+  // procman's backoff: the n-th restart in a row waits restart_delay_s * 2^(n-1), at most
+  // restart_delay_max_s; a run that lasted longer than restart_delay_max_s starts the doubling over.
   double restart_delay_s = 1.0;
+  double restart_delay_max_s = 30.0;
   bool required = true;      // its failure (after restarts) fails the whole set
   bool ends_set = false;     // its successful exit ends the whole set (e.g. the clock after N ticks)
   double start_delay_s = 0;  // wall seconds after the set starts
@@ -31,6 +34,7 @@ struct LaunchSet {
   std::string file;
   std::map<std::string, std::string> args;  // after overrides
   std::string log_dir;  // every process's output also goes to log_dir/NAME.log (empty: none)
+  std::vector<std::string> dirs;  // created before any process starts (where they keep state)
   std::vector<ProcessSpec> processes;
 };
 
@@ -53,5 +57,8 @@ enum class ExitAction {
 // What to do when `spec`'s process exited with `exit_code` (128 + signal for a signal) after
 // `restarts` restarts; `stopping` is true once the set is being stopped anyway.
 ExitAction on_process_exit(const ProcessSpec& spec, int exit_code, int restarts, bool stopping);
+
+// Seconds before the `in_a_row`-th consecutive restart (1 for the first): the backoff above.
+double restart_delay(const ProcessSpec& spec, int in_a_row);
 
 }  // namespace semx::tools

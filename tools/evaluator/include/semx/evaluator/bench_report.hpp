@@ -32,6 +32,10 @@ struct BenchRun {
   // end game, and the metres flown over ground flown before.
   std::vector<double> split_s;
   double revisit_by_place_m = 0;
+  // A process of the set was restarted during the run (metrics.json "disturbed"): listed under
+  // the tables, never in them; `restarts` says which and when ("mapper 12.3 s, ...").
+  bool disturbed = false;
+  std::string restarts;
 };
 
 // Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
@@ -55,7 +59,7 @@ struct BenchReportOptions {
 // runs paired by world and seed, differences relative to the baseline's run.
 inline constexpr const char* kGeneratedPrefix = "generated";
 
-// Markdown (only the valid runs; those that are not are listed under the tables): the sweep
+// Markdown (only the valid, undisturbed runs; the others are listed under the tables): the sweep
 // table, the comparison table (with Time_95, the end game and Time_o, the
 // objects' 75 %, after the paper's columns), every planner's times and distance as multiples of
 // the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
@@ -63,7 +67,7 @@ inline constexpr const char* kGeneratedPrefix = "generated";
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
 // One row per run (the columns of metrics.csv plus the folder).
 std::string bench_csv(const std::vector<BenchRun>& runs);
-// DIR/coverage_WORLD.png per world: the mean coverage curve over seeds of every planner at the
+// DIR/coverage_WORLD.png per world (undisturbed runs): the mean coverage curve over seeds of every planner at the
 // comparison density. Returns the files written.
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
                                            const BenchReportOptions& options = {});

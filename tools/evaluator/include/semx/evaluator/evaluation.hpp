@@ -16,11 +16,14 @@
 
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <vector>
 #include <optional>
 #include <string>
 
 #include "semx/core/time_split.hpp"
+#include "semx/core/byte_io.hpp"
 #include "semx/evaluator/coverage_tracker.hpp"
 #include "semx/evaluator/run_metrics.hpp"
 #include "semx/evaluator/run_summary.hpp"
@@ -60,6 +63,13 @@ class Evaluation {
   // Ends the run now (kEpisodeEnd at utime).
   void on_episode_end(int64_t utime, double wall_s);
 
+  // ---- the set's processes ----
+  // The NODE_STATUS of `node` (its pid and the launcher's restart count) at message time `utime`:
+  // a higher count, or another pid with the same count, than last heard is a restart (a node
+  // first heard with a count above 0 came back before this evaluator heard it).
+  void on_node_status(const std::string& node, int pid, int restarts, int64_t utime);
+  const std::vector<NodeRestart>& restarts() const { return restarts_; }
+
   // ---- time ----
   // The reason the run should end if message time has reached `utime`, if any.
   std::optional<Termination> due(int64_t utime) const;
@@ -87,6 +97,13 @@ class Evaluation {
 
   RunSummary summary() const;
 
+  // ---- saved state (semx-evaluator's --state journal) ----
+  using Saved = RunMetrics::Saved;
+  // One journal record (RunMetrics::save, plus the planner, map and restart records).
+  void save(core::ByteWriter& w, Saved& saved) const;
+  // Applies one record; throws std::runtime_error (or std::out_of_range when it is cut short).
+  void restore(core::ByteReader& r);
+
  private:
   // Rebuilds the ground truth when the map's resolution is not the tracker's; true if it did.
   bool ensure_resolution(double resolution);
@@ -105,6 +122,12 @@ class Evaluation {
   int64_t map_seq_ = 0;
   double wall_s_ = 0.0;
   std::vector<std::string> invalid_reasons_;
+  struct NodeSeen {
+    int pid = 0;
+    int restarts = 0;
+  };
+  std::map<std::string, NodeSeen> nodes_;
+  std::vector<NodeRestart> restarts_;
 };
 
 }  // namespace semx::evaluator

@@ -30,6 +30,7 @@
 #include <utility>
 #include <vector>
 
+#include "semx/core/byte_io.hpp"
 #include "semx/core/states.hpp"
 
 namespace semx::evaluator {
@@ -114,6 +115,20 @@ class RunMetrics {
   const std::vector<CoverageSample>& samples() const { return samples_; }
   const std::vector<Eigen::Vector3d>& trajectory() const { return trajectory_; }
   std::optional<Eigen::Vector3d> position() const;
+
+  // ---- saved state (an evaluator restarted after a crash goes on from it) ----
+  // How much of the growing series the saves so far hold.
+  struct Saved {
+    size_t trajectory = 0, samples = 0, growth = 0;
+  };
+  // What a save now would leave saved (after a restore: what the restored state holds).
+  Saved sizes() const { return {trajectory_.size(), samples_.size(), growth_.size()}; }
+  // One journal record: every scalar, and of each series what `saved` does not hold yet (and its
+  // last element again, which sample() may have replaced); updates `saved`.
+  void save(core::ByteWriter& w, Saved& saved) const;
+  // Applies one record of save() on top of this; replaying a journal's records in order rebuilds
+  // the saved object. Throws std::runtime_error for a record that does not continue this state.
+  void restore(core::ByteReader& r);
 
  private:
   void sample(int64_t utime);

@@ -23,6 +23,14 @@ struct RunInfo {
   std::string source = "live";     // "live" (semx-evaluator) or "log" (semx-eval)
 };
 
+// A process of the set that came back during the run (its NODE_STATUS showed a higher restart
+// count or another pid): the run was disturbed, and its figures are not an undisturbed run's.
+struct NodeRestart {
+  std::string node;
+  double t_s = 0.0;  // message time when it was heard back
+  int restarts = 0;  // the launcher's count after this restart (0: the pid changed without one)
+};
+
 struct RunSummary {
   RunInfo info;
   // The paper's metrics.
@@ -56,6 +64,7 @@ struct RunSummary {
   int64_t covered_voxels = 0;
   int64_t object_voxels = 0;  // the objects' surface voxels in the target set
   int64_t map_seq = 0;  // last map sequence number applied
+  std::vector<NodeRestart> restarts;  // empty: an undisturbed run
   std::vector<CoverageSample> coverage;
   std::vector<Eigen::Vector3d> trajectory;
   // Where the time went: new space, revisits, turns, hover, end game (time_split.json/.png).
