@@ -7,6 +7,8 @@ namespace semx::runtime {
 
 namespace {
 
+enum class Values { kRandom, kNonFinite, kExtreme };
+
 struct Emitter {
   const LcmSchema& schema;
   std::mt19937_64& rng;
@@ -15,9 +17,44 @@ struct Emitter {
   // Offsets of the array-size fields written so far, with their byte widths, so hostile
   // variants can rewrite one.
   std::vector<std::pair<std::size_t, std::size_t>> length_fields;
+  Values values = Values::kRandom;
 
   void put_int(int64_t v, std::size_t bytes) {
     for (std::size_t i = 0; i < bytes; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * (bytes - 1 - i))));
+  }
+
+  // Finite values in kRandom: the decodable-but-wrong kinds are asked for by name.
+  double real_value() {
+    switch (values) {
+      case Values::kNonFinite: {
+        static constexpr double kBad[] = {std::numeric_limits<double>::quiet_NaN(),
+                                          std::numeric_limits<double>::infinity(),
+                                          -std::numeric_limits<double>::infinity(), 1e300};
+        return kBad[rng() % 4];
+      }
+      case Values::kExtreme: {
+        static constexpr double kEdge[] = {0.0, 1.0, -1.0, 1e9, -1e9};
+        return kEdge[rng() % 5];
+      }
+      case Values::kRandom:
+        break;
+    }
+    return std::uniform_real_distribution<double>(-1e3, 1e3)(rng);
+  }
+
+  int64_t extreme_int(std::size_t bytes) {
+    const unsigned bits = static_cast<unsigned>(8 * bytes);
+    const int64_t max = bits >= 64 ? std::numeric_limits<int64_t>::max() : (int64_t{1} << (bits - 1)) - 1;
+    switch (rng() % 4) {
+      case 0:
+        return static_cast<int64_t>(rng() % 4);  // small enum values: DONE, EPISODE_END, ...
+      case 1:
+        return -1;
+      case 2:
+        return max;
+      default:
+        return -max - 1;
+    }
   }
 
   void emit(const LcmStruct& s) {
@@ -57,21 +94,19 @@ struct Emitter {
               length_fields.emplace_back(out.size(), bytes);
               put_int(ints[fi], bytes);
             } else if (f.kind == LcmPrimitive::kFloat || f.kind == LcmPrimitive::kDouble) {
-              // Finite values only: NaN payloads are tested separately by the consumers.
-              std::uniform_real_distribution<double> u(-1e3, 1e3);
+              const double v = real_value();
               if (f.kind == LcmPrimitive::kFloat) {
-                const float v = static_cast<float>(u(rng));
+                const float fv = static_cast<float>(v);
                 uint32_t bits;
-                std::memcpy(&bits, &v, 4);
+                std::memcpy(&bits, &fv, 4);
                 put_int(bits, 4);
               } else {
-                const double v = u(rng);
                 uint64_t bits;
                 std::memcpy(&bits, &v, 8);
                 put_int(static_cast<int64_t>(bits), 8);
               }
             } else {
-              const int64_t v = static_cast<int64_t>(rng());
+              const int64_t v = values == Values::kExtreme ? extreme_int(bytes) : static_cast<int64_t>(rng());
               put_int(v, bytes);
               if (f.dims.empty()) {
                 // Keep the sign-extended value: it is what an array size would read back as.
@@ -90,7 +125,7 @@ struct Emitter {
 
 std::vector<uint8_t> random_wire_message(const LcmSchema& schema, const LcmStruct& type, std::mt19937_64& rng,
                                          int max_array) {
-  Emitter e{schema, rng, max_array, {}, {}};
+  Emitter e{schema, rng, max_array, {}, {}, Values::kRandom};
   e.put_int(schema.fingerprint(type), 8);
   e.emit(type);
   return std::move(e.out);
@@ -112,6 +147,10 @@ const char* to_string(HostileKind k) {
       return "random-bytes";
     case HostileKind::kBitFlip:
       return "bit-flip";
+    case HostileKind::kNonFinite:
+      return "non-finite";
+    case HostileKind::kExtreme:
+      return "extreme";
   }
   return "?";
 }
@@ -122,9 +161,21 @@ std::vector<HostileKind> all_hostile_kinds() {
           HostileKind::kBitFlip};
 }
 
+bool has_real_field(const LcmSchema& schema, const LcmStruct& type) {
+  for (const auto& f : type.fields) {
+    if (f.kind == LcmPrimitive::kFloat || f.kind == LcmPrimitive::kDouble) return true;
+    if (f.kind == LcmPrimitive::kStruct && has_real_field(schema, schema.structs().at(f.struct_name))) return true;
+  }
+  return false;
+}
+
+std::vector<HostileKind> decodable_hostile_kinds() { return {HostileKind::kNonFinite, HostileKind::kExtreme}; }
+
 std::vector<uint8_t> hostile_wire_message(const LcmSchema& schema, const LcmStruct& type, HostileKind kind,
                                           std::mt19937_64& rng) {
-  Emitter e{schema, rng, 4, {}, {}};
+  Emitter e{schema, rng, 4, {}, {}, Values::kRandom};
+  if (kind == HostileKind::kNonFinite) e.values = Values::kNonFinite;
+  if (kind == HostileKind::kExtreme) e.values = Values::kExtreme;
   e.put_int(schema.fingerprint(type), 8);
   e.emit(type);
   std::vector<uint8_t> m = std::move(e.out);
@@ -163,6 +214,9 @@ std::vector<uint8_t> hostile_wire_message(const LcmSchema& schema, const LcmStru
       for (int i = 0; i < 4 && m.size() > 8; ++i)
         m[8 + rng() % (m.size() - 8)] ^= static_cast<uint8_t>(1u << (rng() % 8));
       break;
+    case HostileKind::kNonFinite:
+    case HostileKind::kExtreme:
+      break;  // the values are the attack
   }
   return m;
 }

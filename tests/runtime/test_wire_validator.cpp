@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "all_types.hpp"
@@ -60,7 +61,59 @@ void check_hostile_messages(std::mt19937_64& rng) {
   }
 }
 
+// The decodable kinds are well-formed: only a node's own checks can refuse them. non-finite
+// carries a non-finite value wherever the type has a real field (1e300 turns to inf in a float).
+template <class T>
+void check_decodable_hostile_messages(std::mt19937_64& rng) {
+  const auto& schema = LcmSchema::semx();
+  const auto* type = schema.find(std::string("semx.") + T::getTypeName());
+  ASSERT_NE(type, nullptr);
+  for (auto kind : decodable_hostile_kinds()) {
+    int with_bad_value = 0;
+    for (int i = 0; i < 20; ++i) {
+      const auto bytes = hostile_wire_message(schema, *type, kind, rng);
+      ASSERT_EQ(validate_wire(schema, *type, T::getHash(), bytes.data(), bytes.size()), WireError::kNone)
+          << T::getTypeName() << " " << to_string(kind);
+      T msg;
+      ASSERT_EQ(msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()))
+          << T::getTypeName() << " " << to_string(kind);
+      // utime, the first field of every message type: the extreme kind's integers reach it.
+      if (kind == HostileKind::kExtreme && type->fields.front().name == "utime") {
+        int64_t utime = 0;
+        for (int b = 0; b < 8; ++b) utime = static_cast<int64_t>(static_cast<uint64_t>(utime) << 8 | bytes[8 + b]);
+        if (utime < 0 || utime > 3) ++with_bad_value;
+      }
+    }
+    if (kind == HostileKind::kExtreme && type->fields.front().name == "utime") {
+      EXPECT_GT(with_bad_value, 0) << T::getTypeName();
+    }
+  }
+}
+
 }  // namespace
+
+TEST(WireValidator, DecodableHostileMessagesOfEveryTypeDecode) {
+  std::mt19937_64 rng(3);
+#define DH(T) check_decodable_hostile_messages<semx::T>(rng);
+  SEMX_ALL_TYPES(DH)
+#undef DH
+}
+
+TEST(WireValidator, NonFiniteMessagesCarryNonFiniteValues) {
+  const auto& schema = LcmSchema::semx();
+  const auto* type = schema.find("semx.odometry_t");
+  ASSERT_NE(type, nullptr);
+  ASSERT_TRUE(has_real_field(schema, *type));
+  std::mt19937_64 rng(4);
+  for (int i = 0; i < 20; ++i) {
+    const auto bytes = hostile_wire_message(schema, *type, HostileKind::kNonFinite, rng);
+    semx::odometry_t o;
+    ASSERT_EQ(o.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+    bool any_bad = false;
+    for (double v : o.position) any_bad = any_bad || !std::isfinite(v) || std::abs(v) > 1e200;
+    EXPECT_TRUE(any_bad || !std::isfinite(o.velocity[0]) || std::abs(o.velocity[0]) > 1e200);
+  }
+}
 
 TEST(WireValidator, RandomMessagesOfEveryTypeValidateDecodeAndReencodeIdentically) {
   std::mt19937_64 rng(1);

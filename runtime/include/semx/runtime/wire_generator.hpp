@@ -25,9 +25,20 @@ enum class HostileKind {
   kWrongFingerprint,
   kRandomBytes,  // noise of random size
   kBitFlip,      // a valid message with random bits flipped
+  // Decodable messages whose values are wrong, which only a node's own checks can catch:
+  kNonFinite,  // every float or double field NaN, +inf, -inf or 1e300 (from a float: inf)
+  kExtreme,    // integers 0..3, -1 or their type's extremes (utime INT64_MAX, tick 2^63-1, enum
+               // values that mean DONE or EPISODE_END); floats 0, +-1, +-1e9
 };
 const char* to_string(HostileKind k);
+// The seven malformed kinds (bytes a decoder must refuse), not the decodable ones below them.
 std::vector<HostileKind> all_hostile_kinds();
+// kNonFinite and kExtreme: decodable, wrong in value.
+std::vector<HostileKind> decodable_hostile_kinds();
+
+// Whether `type` (or a struct inside it) has a float or double field: kNonFinite on a type
+// without one is a plain random message, which may well be valid.
+bool has_real_field(const LcmSchema& schema, const LcmStruct& type);
 
 // A hostile variant of a random message of `type`. When the type has no array to abuse,
 // kNegativeLength and kHugeLength fall back to a corrupted fingerprint-valid header.
