@@ -512,6 +512,14 @@ void Node::note_handler_error(const std::string& channel, const char* what) {
   }
 }
 
+void Node::note_non_finite_publish(const std::string& channel) {
+  ++non_finite_publishes_;
+  if (worth_logging(non_finite_publishes_)) {
+    std::cerr << options_.name << ": published a " << channel << " message with a NaN or infinite value ("
+              << non_finite_publishes_ << " so far): every semx node drops it\n";
+  }
+}
+
 bool Node::publish_raw(const std::string& channel, const void* data, std::size_t size) {
   const auto* bytes = static_cast<const uint8_t*>(data);
   publish_buffer_.reserve(size + kAuthTrailerBytes);

@@ -23,6 +23,8 @@ const char* to_string(WireError e) {
       return "trailing bytes";
     case WireError::kTooDeep:
       return "nesting too deep";
+    case WireError::kNonFinite:
+      return "NaN or infinite value";
   }
   return "?";
 }
@@ -33,8 +35,8 @@ constexpr int kMaxDepth = 8;
 
 class Walker {
  public:
-  Walker(const LcmSchema& schema, const uint8_t* data, std::size_t size)
-      : schema_(schema), data_(data), size_(size) {}
+  Walker(const LcmSchema& schema, const uint8_t* data, std::size_t size, bool finite_reals)
+      : schema_(schema), data_(data), size_(size), finite_reals_(finite_reals) {}
 
   WireError walk(const LcmStruct& s, int depth) {
     if (depth > kMaxDepth) return WireError::kTooDeep;
@@ -77,6 +79,14 @@ class Walker {
           return f.dims.empty() ? WireError::kTooShort : WireError::kLengthExceedsBuffer;
         if (f.dims.empty() && is_integer(f.kind)) {
           ints[fi] = read_int(each);
+        } else if (finite_reals_ && (f.kind == LcmPrimitive::kFloat || f.kind == LcmPrimitive::kDouble)) {
+          // Big-endian IEEE 754: the exponent is all ones for NaN and inf alone.
+          const bool is_double = f.kind == LcmPrimitive::kDouble;
+          for (uint64_t k = 0; k < count; ++k, pos_ += each) {
+            const unsigned exponent = is_double ? ((data_[pos_] & 0x7Fu) << 4) | (data_[pos_ + 1] >> 4)
+                                                : ((data_[pos_] & 0x7Fu) << 1) | (data_[pos_ + 1] >> 7);
+            if (exponent == (is_double ? 0x7FFu : 0xFFu)) return WireError::kNonFinite;
+          }
         } else {
           pos_ += static_cast<std::size_t>(count) * each;
         }
@@ -101,18 +111,19 @@ class Walker {
   const LcmSchema& schema_;
   const uint8_t* data_;
   std::size_t size_;
+  bool finite_reals_;
   std::size_t pos_ = 0;
 };
 
 }  // namespace
 
 WireError validate_wire(const LcmSchema& schema, const LcmStruct& type, int64_t fingerprint,
-                        const uint8_t* data, std::size_t size) {
+                        const uint8_t* data, std::size_t size, bool finite_reals) {
   if (data == nullptr || size < 8) return WireError::kTooShort;
   uint64_t hash = 0;
   for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[i];
   if (static_cast<int64_t>(hash) != fingerprint) return WireError::kFingerprint;
-  Walker w(schema, data, size);
+  Walker w(schema, data, size, finite_reals);
   w.skip(8);
   const WireError e = w.walk(type, 0);
   if (e != WireError::kNone) return e;

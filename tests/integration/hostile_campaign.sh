@@ -111,7 +111,7 @@ echo
 echo "| | undisturbed | attacked |"
 echo "|---|---|---|"
 same=1
-for k in time_f_s coverage_pct time_r_s time_o_s distance_m collisions termination valid; do
+for k in time_f_s coverage_pct time_r_s time_o_s distance_m collisions termination valid disturbed; do
   a=$(json "$out/clean/metrics.json" "$k")
   b=$(json "$out/attacked/metrics.json" "$k" 2>/dev/null)
   [ "$a" = "$b" ] || same=0

@@ -1,16 +1,18 @@
 // The node runtime over memq:// (one process, publish and handle on the same LCM object).
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 #include <chrono>
 
 #include <fstream>
+#include <limits>
 #include <random>
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/node_status_t.hpp>
 #include <semx/odometry_t.hpp>
+#include <semx/controller_status_t.hpp>
 #include <semx/path_t.hpp>
+#include <semx/sim_event_t.hpp>
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/node.hpp"
@@ -120,6 +122,28 @@ TEST(Node, HostileBytesAreCountedDroppedAndNeverReachTheHandler) {
   n.publish("PLAN_PATH", good);
   drain(n);
   EXPECT_EQ(delivered, 1);
+}
+
+// No handler sees a NaN or an inf, whichever field and whatever the subscriber checks itself:
+// an evaluator without a check on SIM_EVENT once counted a COLLISION at (nan, inf, 1e300).
+TEST(Node, NonFiniteValuesNeverReachAHandler) {
+  Node n(memq("victim"));
+  int events = 0, statuses = 0;
+  n.subscribe<semx::sim_event_t>("SIM_EVENT", [&](const semx::sim_event_t&) { ++events; });
+  n.subscribe<semx::controller_status_t>("CONTROLLER_STATUS", [&](const semx::controller_status_t&) { ++statuses; });
+  semx::sim_event_t e{};
+  e.type = semx::sim_event_t::COLLISION;
+  e.count = 1;
+  n.publish("SIM_EVENT", e);
+  e.position[1] = std::numeric_limits<double>::infinity();
+  n.publish("SIM_EVENT", e);
+  semx::controller_status_t c{};
+  c.progress = std::nan("");
+  n.publish("CONTROLLER_STATUS", c);
+  drain(n);
+  EXPECT_EQ(events, 1);
+  EXPECT_EQ(statuses, 0);
+  EXPECT_EQ(n.counters().malformed, 2);
 }
 
 TEST(Node, ContentCheckRejectsAsMalformed) {

@@ -243,6 +243,7 @@ class Node {
   void note_malformed(const std::string& channel, const std::string& why, std::size_t size);
   void note_handler_error(const std::string& channel, const char* what);
   const LcmStruct& schema_of(const char* type_name) const;
+  void note_non_finite_publish(const std::string& channel);
 
   NodeOptions options_;
   std::unique_ptr<lcm::LCM> lcm_;  // other providers only
@@ -299,6 +300,7 @@ class Node {
   int64_t tick_period_us_ = 0;
   bool in_tick_ = false;
   int64_t early_publishes_ = 0;
+  int64_t non_finite_publishes_ = 0;
   SimClock clock_;
   NodeState state_ = NodeState::kStarting;
   std::string detail_;
@@ -325,7 +327,7 @@ struct Node::TypedSubscription : Node::Subscription {
   std::function<bool(const T&)> accept;
 
   Outcome deliver(const uint8_t* data, std::size_t size, std::string& why) override {
-    const WireError e = validate_wire(LcmSchema::semx(), *type, T::getHash(), data, size);
+    const WireError e = validate_wire(LcmSchema::semx(), *type, T::getHash(), data, size, true);
     if (e != WireError::kNone) {
       why = to_string(e);
       return Outcome::kMalformed;
@@ -383,6 +385,11 @@ bool Node::publish(const std::string& channel, const T& msg) {
     ++c.dropped;
     ++counters_.dropped;
     return false;
+  }
+  // Every receiver drops a message with a NaN or inf in it: say so where the bug is.
+  if (validate_wire(LcmSchema::semx(), schema_of(T::getTypeName()), T::getHash(), encode_buffer_.data(),
+                    encode_buffer_.size(), true) == WireError::kNonFinite) {
+    note_non_finite_publish(channel);
   }
   return send_signed(channel, encode_buffer_);
 }

@@ -26,9 +26,9 @@ enum class HostileKind {
   kRandomBytes,  // noise of random size
   kBitFlip,      // a valid message with random bits flipped
   // Decodable messages whose values are wrong, which only a node's own checks can catch:
-  kNonFinite,  // every float or double field NaN, +inf, -inf or 1e300 (from a float: inf)
+  kNonFinite,  // every float or double field NaN, +inf or -inf
   kExtreme,    // integers 0..3, -1 or their type's extremes (utime INT64_MAX, tick 2^63-1, enum
-               // values that mean DONE or EPISODE_END); floats 0, +-1, +-1e9
+               // values that mean DONE or EPISODE_END); reals 0, +-1, +-1e9, 1e300
 };
 const char* to_string(HostileKind k);
 // The seven malformed kinds (bytes a decoder must refuse), not the decodable ones below them.
