@@ -274,7 +274,8 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
     note_refused(channel, verdict, trailer);
     return;
   }
-  if (tracked(channel)) {
+  const bool in_order = tracked(channel) && trailer.seq != 0;  // seq 0: an observer's (send_signed)
+  if (in_order) {
     const StreamKey stream{trailer.sender, channel_tag(channel)};
     switch (inbox_.arrive(stream, trailer.seq, channel, data, size, wall_s())) {
       case Inbox::Arrival::kDuplicate:
@@ -284,7 +285,7 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
         break;
     }
   }
-  if (!tracked(channel)) {
+  if (!in_order) {
     dispatch(channel, data, size, size - kAuthTrailerBytes);
     return;
   }
@@ -531,7 +532,10 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
   AuthTrailer trailer;
   if (options_.sign) {
     if (channel.empty() || channel.size() > kLcmMaxChannel) return false;
-    trailer = signer_.sign(channel, bytes);
+    // An observer's messages (its heartbeat, its resend requests) are not part of any run:
+    // seq 0 tells readers not to wait for, ask for or count them, so an observer that ends or
+    // loses datagrams never holds a lockstep tick or makes a run invalid.
+    trailer = options_.observer ? signer_.sign_as(channel, bytes, 0) : signer_.sign(channel, bytes);
   }
   const uint8_t* data = bytes.data();
   const std::size_t size = bytes.size();
@@ -551,7 +555,7 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
     ++c.dropped;
     ++counters_.dropped;
     // Kept all the same: its sequence number is spent, and a reader will ask for it.
-    if (options_.sign && tracked(channel))
+    if (options_.sign && tracked(channel) && trailer.seq != 0)
       bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
     return false;
   }
@@ -560,7 +564,9 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
   c.bytes += static_cast<int64_t>(options_.sign ? size - kAuthTrailerBytes : size);
   ++counters_.sent;
   // Kept for a reader that lost it; the buffer handed back is reused by the next message.
-  if (options_.sign && tracked(channel)) bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
+  if (options_.sign && tracked(channel) && trailer.seq != 0) {
+    bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
+  }
   return true;
 }
 
