@@ -7,7 +7,7 @@
 # process exits) beside the undisturbed run's.
 #
 #   tests/integration/hostile_campaign.sh [--world env1] [--seed 1] [--time-limit 60]
-#       [--min 100000] [--streams 4] [--rate 1000] [--batch 150] [--out DIR] [--build DIR]
+#       [--min 100000] [--streams 4] [--rate 3000] [--batch 600] [--out DIR] [--build DIR]
 #
 # Senders, per channel, in turn (--streams of them at once, each at --rate messages/s):
 #   insider:  signed with the set's key: truncated, oversized, negative and huge array lengths,
@@ -20,7 +20,7 @@
 # (the threat model, docs/runtime.md). Runs in a private network namespace when it can (root).
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
-world=env1 seed=1 time_limit=60 min=100000 streams=4 rate=1000 batch=150 out="" build="$ROOT/build" in_netns=""
+world=env1 seed=1 time_limit=60 min=100000 streams=4 rate=3000 batch=600 out="" build="$ROOT/build" in_netns=""
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
