@@ -131,8 +131,10 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
   node_.subscribe<semx::node_status_t>(ch::NODE_STATUS, [this](const semx::node_status_t& m) {
     // A recorder's or viewer's losses leave its log or picture short, not the run.
     if (m.lost > 0 && !m.observer) lost_[m.node] = std::max(lost_[m.node], m.lost);
-    // Nor does an observer that comes and goes (a viewer opened twice) disturb it.
-    if (m.observer) return;
+    // Nor does an observer that comes and goes (a viewer opened twice, another pid under one
+    // name): only one the launcher brought back (its restart count rises: the set's logger, whose
+    // log now has a hole) is recorded.
+    if (m.observer && m.restarts <= 0) return;
     const int64_t t = std::max(node_.now_utime(), evaluation_.metrics().now_utime());
     const size_t before = evaluation_.restarts().size();
     evaluation_.on_node_status(m.node, m.pid, m.restarts, t);
