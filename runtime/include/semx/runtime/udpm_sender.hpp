@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/runtime/bus_pacer.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
 
 namespace semx::runtime {
@@ -29,8 +30,9 @@ uint32_t channel_tag(const std::string& channel);
 
 class UdpmSender {
  public:
-  // Throws std::runtime_error naming the endpoint and the failing call.
-  explicit UdpmSender(const UdpmEndpoint& endpoint);
+  // Throws std::runtime_error naming the endpoint and the failing call. `pace`: every datagram
+  // waits for its turn (bus_pacer.hpp); by default what SEMX_BUS_PACE says, i.e. none.
+  explicit UdpmSender(const UdpmEndpoint& endpoint, BusPace pace = bus_pace_from_env());
   ~UdpmSender();
   UdpmSender(const UdpmSender&) = delete;
   UdpmSender& operator=(const UdpmSender&) = delete;
@@ -44,6 +46,7 @@ class UdpmSender {
 
  private:
   int fd_ = -1;
+  BusPacer pacer_;
   std::vector<uint8_t> header_;
   uint8_t counter_ = 0;
   uint32_t group_ = 0;  // network order
