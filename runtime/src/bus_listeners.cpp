@@ -64,7 +64,8 @@ std::vector<UdpSocketInfo> udp_sockets_on_port(const std::string& table, int por
   return out;
 }
 
-BusListeners::BusListeners(int port, std::string own_exe_dir, double max_hold_s, double rescan_s, std::string proc)
+BusListeners::BusListeners(int port, std::string own_exe_dir, double max_hold_s, double rescan_s,
+                           std::string proc)
     : port_(port),
       own_exe_dir_(std::move(own_exe_dir)),
       max_hold_s_(max_hold_s),

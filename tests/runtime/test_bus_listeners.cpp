@@ -21,10 +21,11 @@ const char* kHeader =
 
 std::string udp_line(int port, unsigned rx_queue, unsigned long inode) {
   char buf[256];
-  std::snprintf(buf, sizeof buf,
-                " 2243: 00000000:%04X 00000000:0000 07 00000000:%08X 00:00000000 00000000     0        0 %lu 2 "
-                "00000000fb493afc 0\n",
-                port, rx_queue, inode);
+  std::snprintf(
+      buf, sizeof buf,
+      " 2243: 00000000:%04X 00000000:0000 07 00000000:%08X 00:00000000 00000000     0        0 %lu 2 "
+      "00000000fb493afc 0\n",
+      port, rx_queue, inode);
   return buf;
 }
 
@@ -43,8 +44,8 @@ class FakeProc {
   ~FakeProc() { fs::remove_all(root_); }
   std::string path() const { return root_.string(); }
   void table(unsigned stock_rx_queue) {
-    std::ofstream(root_ / "net" / "udp") << kHeader << udp_line(7667, 0, 11) << udp_line(7667, stock_rx_queue, 22)
-                                         << udp_line(7668, 0, 33);
+    std::ofstream(root_ / "net" / "udp")
+        << kHeader << udp_line(7667, 0, 11) << udp_line(7667, stock_rx_queue, 22) << udp_line(7668, 0, 33);
   }
   void thread(int pid, int tid, char state) {
     std::ofstream(root_ / std::to_string(pid) / "task" / std::to_string(tid) / "stat")
@@ -52,7 +53,8 @@ class FakeProc {
   }
 
  private:
-  void process(int pid, const std::string& exe, unsigned long inode, std::vector<std::pair<int, char>> threads) {
+  void process(int pid, const std::string& exe, unsigned long inode,
+               std::vector<std::pair<int, char>> threads) {
     const fs::path p = root_ / std::to_string(pid);
     fs::create_directories(p / "fd");
     fs::create_symlink("socket:[" + std::to_string(inode) + "]", p / "fd" / "3");

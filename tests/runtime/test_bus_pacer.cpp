@@ -64,7 +64,8 @@ TEST(BusPacer, ADatagramCostsAtLeastItsFloor) {
 
 TEST(BusPacer, TheSenderWaitsItsTurn) {
   // A port of its own, next to test_udpm.cpp's (offsets 0-8 of 40000 + 10 per pid).
-  const auto endpoint = parse_udpm_url(udpm_url_for_port(40000 + (static_cast<int>(getpid()) % 2000) * 10 + 9));
+  const auto endpoint =
+      parse_udpm_url(udpm_url_for_port(40000 + (static_cast<int>(getpid()) % 2000) * 10 + 9));
   ASSERT_TRUE(endpoint);
   std::vector<uint8_t> frame(1'000'000, 7);
   // 0.5 MB beyond the burst at 5 MB/s: 0.1 s at least, however fast the machine.

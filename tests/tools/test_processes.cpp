@@ -525,14 +525,15 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   const std::string ours = temp_path("stock_ours.lcmlog");
   const std::string stock = temp_path("stock.lcmlog");
   const std::string set = temp_path("stock.yaml");
-  std::ofstream(set) << "name: stock-test\nprocesses:\n"
-                        "  - name: logger\n    command: [semx-logger, --quiet, --force, \""
-                     << ours
-                     << "\"]\n    required: false\n"
-                        "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
-                        "  - name: simulator\n    command: [semx-simulator, --world, env1, --clock, lockstep, "
-                        "--lockstep-nodes, monitor, --duration, \"3\", --progress, \"0\", --no-rgb]\n"
-                        "    ends_set: true\n    start_delay: 1.0\n";
+  std::ofstream(set)
+      << "name: stock-test\nprocesses:\n"
+         "  - name: logger\n    command: [semx-logger, --quiet, --force, \""
+      << ours
+      << "\"]\n    required: false\n"
+         "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+         "  - name: simulator\n    command: [semx-simulator, --world, env1, --clock, lockstep, "
+         "--lockstep-nodes, monitor, --duration, \"3\", --progress, \"0\", --no-rgb]\n"
+         "    ends_set: true\n    start_delay: 1.0\n";
   std::filesystem::remove(stock);
   Process logger({stock_bin, "--lcm-url=udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0", stock},
                  temp_path("stock_logger.out"));
@@ -562,6 +563,7 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   EXPECT_GE(held["CAMERA_DEPTH"], 25) << "3 simulated seconds at 10 Hz";
   EXPECT_GE(held["SIM_CLOCK"], 300);
   for (const auto& [channel, n] : missing)
-    ADD_FAILURE() << n << " of the " << held[channel] << " " << channel << " messages semx-logger recorded are not in "
+    ADD_FAILURE() << n << " of the " << held[channel] << " " << channel
+                  << " messages semx-logger recorded are not in "
                   << "the stock lcm-logger's log";
 }

@@ -8,11 +8,11 @@
 // sockets; the processes of this user, or all as root).
 #pragma once
 
+#include <sys/types.h>
 #include <cstddef>
 #include <cstdint>
 #include <set>
 #include <string>
-#include <sys/types.h>
 #include <vector>
 
 namespace semx::runtime {
@@ -52,8 +52,8 @@ class BusListeners {
   bool has_room(double wall_s, uint32_t max_queued);
 
   const std::vector<pid_t>& foreign() const { return pids_; }
-  int64_t holds() const { return holds_; }          // caught_up() calls that said false
-  int64_t gave_up() const { return gave_up_; }      // times max_hold_s ran out
+  int64_t holds() const { return holds_; }      // caught_up() calls that said false
+  int64_t gave_up() const { return gave_up_; }  // times max_hold_s ran out
 
  private:
   void rescan();
@@ -68,7 +68,7 @@ class BusListeners {
   std::string proc_;
   double next_scan_s_ = -1;
   double holding_since_s_ = -1;
-  std::set<uint64_t> inodes_;         // every socket on the port at the last scan
+  std::set<uint64_t> inodes_;  // every socket on the port at the last scan
   std::set<uint64_t> foreign_inodes_;
   std::vector<pid_t> pids_;
   int64_t holds_ = 0;
