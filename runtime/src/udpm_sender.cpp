@@ -1,5 +1,7 @@
 #include "semx/runtime/udpm_sender.hpp"
 
+#include "semx/runtime/executable_dir.hpp"
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -8,8 +10,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
 
 namespace semx::runtime {
 
@@ -26,6 +30,10 @@ void put16(uint8_t* p, uint16_t v) {
   p[1] = static_cast<uint8_t>(v);
 }
 
+double monotonic_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 }  // namespace
 
 uint32_t channel_tag(const std::string& channel) {
@@ -34,7 +42,12 @@ uint32_t channel_tag(const std::string& channel) {
   return 1 + (h ^ (h >> 20)) % kSeqnoTagBits;
 }
 
-UdpmSender::UdpmSender(const UdpmEndpoint& endpoint) : header_(kLcmLongHeader + kLcmMaxChannel + 1) {
+UdpmSender::UdpmSender(const UdpmEndpoint& endpoint, BusPace pace, double foreign_hold_s)
+    : pacer_(pace), header_(kLcmLongHeader + kLcmMaxChannel + 1) {
+  if (foreign_hold_s > 0) {
+    listeners_ = std::make_unique<BusListeners>(endpoint.port, executable_dir(), foreign_hold_s);
+    foreign_room_ = foreign_room_bytes();
+  }
   const std::string name = "udpm://" + endpoint.group + ":" + std::to_string(endpoint.port);
   auto fail = [&](const char* what) {
     const std::string msg = name + ": " + what + ": " + std::strerror(errno);
@@ -76,6 +89,15 @@ bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::s
   msg.msg_iov = iov;
   msg.msg_iovlen = 2;
   auto send = [&](std::size_t header, const uint8_t* part, std::size_t n) {
+    // A large datagram fills a small buffer: it goes once a reader outside the set has room.
+    if (listeners_ && header + n >= 8192) {
+      while (!listeners_->has_room(monotonic_s(), foreign_room_))
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (pacer_.active()) {
+      const double wait_s = pacer_.delay(header + n, monotonic_s());
+      if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+    }
     iov[0] = {header_.data(), header};
     iov[1] = {const_cast<uint8_t*>(part), n};
     return ::sendmsg(fd_, &msg, 0) == static_cast<ssize_t>(header + n);

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "semx/runtime/bus_listeners.hpp"
 #include "semx/runtime/node_flags.hpp"
 #include "semx/runtime/restart_count.hpp"
 #include "semx/simulator/world.hpp"
@@ -14,7 +15,8 @@ int main(int argc, char** argv) {
     runtime::NodeFlags flags("simulator");
     std::string world = "env1", config_file, clock = "realtime", nodes, state;
     std::vector<std::string> sets;
-    double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10, ready_timeout = 30;
+    double speed = 1.0, max_speed = 0, duration = 0, period_ms = 10, progress = 10, ready_timeout = 30,
+           foreign_hold = runtime::foreign_hold_from_env();
     bool compress = false, raw = false, no_rgb = false;
     runtime::ArgParser p(
         "semx-simulator",
@@ -30,6 +32,10 @@ int main(int argc, char** argv) {
                 "lockstep: nodes that must ack every tick (none: as fast as possible)", &nodes)
         .option("max-speed", "X", "lockstep: at most X simulated seconds per wall second (default: no cap)",
                 &max_speed)
+        .option("foreign-hold", "S",
+                "lockstep: wait up to S wall seconds per tick for readers of the port outside the set "
+                "(a stock lcm-logger) to take what was sent (default $SEMX_FOREIGN_HOLD, else 0.1; 0: never)",
+                &foreign_hold)
         .option("duration", "S", "end the episode after S simulated seconds (default: run until stopped)",
                 &duration)
         .option("period-ms", "MS", "tick length in simulated ms (default 10, the odometry period)",
@@ -53,6 +59,7 @@ int main(int argc, char** argv) {
     if (!(period_ms > 0)) throw runtime::ArgError("--period-ms must be positive");
     if (!(speed > 0)) throw runtime::ArgError("--speed must be positive");
     if (duration < 0) throw runtime::ArgError("--duration must not be negative");
+    if (!(foreign_hold >= 0)) throw runtime::ArgError("--foreign-hold must not be negative");
     if (!(ready_timeout >= 0)) throw runtime::ArgError("--ready-timeout must not be negative");
 
     const auto cfg = runtime::load_config<simulator::SimulatorConfig>(config_file, sets);
@@ -66,6 +73,7 @@ int main(int argc, char** argv) {
     o.clock.period_us = static_cast<int64_t>(period_ms * 1000.0);
     o.clock.speed = speed;
     o.clock.max_speed = max_speed;
+    o.foreign_hold_s = foreign_hold;
     std::stringstream ss(nodes);
     for (std::string n; std::getline(ss, n, ',');) {
       if (!n.empty()) o.clock.lockstep_nodes.push_back(n);

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "semx/runtime/channels.hpp"
+#include "semx/runtime/executable_dir.hpp"
+#include "semx/runtime/udpm_receiver.hpp"
 #include "simulator_messages.hpp"
 
 namespace semx::simulator {
@@ -34,6 +36,12 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     server_.on_ack(a.node, a.tick, a.quiet_until, wall_seconds());
   });
   next_progress_s_ = options_.progress_every_s;
+  if (options_.clock.mode == runtime::ClockMode::kLockstep && options_.foreign_hold_s > 0 &&
+      node_.own_receiver()) {
+    if (const auto e = runtime::parse_udpm_url(node_.url()))
+      listeners_ = std::make_unique<runtime::BusListeners>(e->port, runtime::executable_dir(),
+                                                           options_.foreign_hold_s);
+  }
   if (!options_.state_path.empty()) {
     // Read before the slot is opened, which empties the file.
     const auto saved = options_.resume ? runtime::read_state_slot(options_.state_path, kStateKind)
@@ -173,7 +181,10 @@ bool SimulatorNode::poll(double wall_s) {
   if (server_.finished()) return false;
   // A command an ack named but that was lost on the way is asked for again before the next
   // tick: the vehicle must fly the run a lossless bus gives.
-  if (auto t = server_.poll(wall_s, node_.holds_everything())) {
+  // A reader outside the set (a stock lcm-logger) is asked only when the tick is otherwise due.
+  const bool held = node_.holds_everything() &&
+                    (!listeners_ || !server_.waiting_for().empty() || listeners_->caught_up(wall_s));
+  if (auto t = server_.poll(wall_s, held)) {
     if (!t->resend) {
       advance_to(t->utime);
       // Saved before the tick goes out: a simulator killed after this resends this tick, one
@@ -218,6 +229,14 @@ int SimulatorNode::run() {
       "%lld commands rejected\n",
       sim_s, wall, sim_s / std::max(1e-9, wall), static_cast<long long>(frames_),
       static_cast<long long>(sim_.vehicle().collisions()), static_cast<long long>(rejected_));
+  if (listeners_ && listeners_->holds() > 0) {
+    // A reader outside the set (a stock lcm-logger) was waited for: the run was slower for it.
+    std::printf("semx-simulator: waited %lld times for readers of the port outside the set (pids",
+                static_cast<long long>(listeners_->holds()));
+    for (pid_t pid : listeners_->foreign()) std::printf(" %d", static_cast<int>(pid));
+    std::printf("), %lld of them cut short after %.2f s\n", static_cast<long long>(listeners_->gave_up()),
+                options_.foreign_hold_s);
+  }
   if (lockstep && !server_.waited_on().empty()) {
     // Whom the clock waited on: the node whose ack completed each tick, and for how long.
     std::vector<std::pair<double, std::string>> w;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "semx/runtime/bus_listeners.hpp"
 #include "semx/runtime/clock_server.hpp"
 #include "semx/runtime/image_codec.hpp"
 #include "semx/runtime/node.hpp"
@@ -38,6 +39,10 @@ struct SimulatorNodeOptions {
   // Wall seconds to wait for the registered nodes before starting without the silent ones (named
   // on stderr; in LOCKSTEP the clock still waits for their acks).
   double ready_timeout_s = 30.0;
+  // LOCKSTEP: before each new tick, wait up to this many wall seconds for readers of the port
+  // that are not the set's (a stock lcm-logger started by hand) to take what was sent
+  // (runtime/bus_listeners.hpp); 0: never wait. Costs nothing while no such reader listens.
+  double foreign_hold_s = 0.1;
   // Where to save the simulation's state every tick (empty: nowhere), and whether to resume from
   // what is there (a restart after a crash): the episode then goes on from the last tick
   // published, which is sent again, never an earlier one (docs/launch.md, "When a process dies").
@@ -91,6 +96,7 @@ class SimulatorNode {
   std::unique_ptr<runtime::StateSlot> state_;
   std::vector<uint8_t> state_bytes_;
   int64_t resumed_at_ = -1;
+  std::unique_ptr<runtime::BusListeners> listeners_;  // LOCKSTEP on udpm with foreign_hold_s > 0
 };
 
 }  // namespace semx::simulator

@@ -2,6 +2,7 @@
 // lcm::LogFile, a burst recorded whole, Ctrl-C leaving nothing behind, restart and failure policies, and a
 // node under a stream of hostile messages.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <lcm/lcm-cpp.hpp>
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
@@ -17,6 +18,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "process_harness.hpp"
 #include "semx/runtime/lcm_url.hpp"
@@ -509,4 +511,59 @@ TEST(Processes, SemxDemoKeepsARunFolderThatIsThere) {
   EXPECT_EQ(demo.wait(30), 2) << read_file(temp_path("demo-kept.out"));
   EXPECT_NE(read_file(temp_path("demo-kept.out")).find("--force"), std::string::npos);
   EXPECT_EQ(read_file(dir + "/metrics.json"), "{}");
+}
+
+// A user's habit: lcm-logger started by hand, with no URL options (the kernel's default receive
+// buffer, liblcm's queue of 30 messages), while a lockstep set runs faster than real time with
+// 600 KB depth frames. The set waits for such a reader (runtime/bus_listeners.hpp), so its log
+// holds every message semx-logger's holds; before, the frames overflowed its buffer.
+TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
+  const std::string stock_bin = "/usr/bin/lcm-logger";
+  if (access(stock_bin.c_str(), X_OK) != 0) GTEST_SKIP() << "no " << stock_bin;
+  const int port = test_port(7);
+  const std::string url = semx::runtime::udpm_url_for_port(port);
+  const std::string ours = temp_path("stock_ours.lcmlog");
+  const std::string stock = temp_path("stock.lcmlog");
+  const std::string set = temp_path("stock.yaml");
+  std::ofstream(set)
+      << "name: stock-test\nprocesses:\n"
+         "  - name: logger\n    command: [semx-logger, --quiet, --force, \""
+      << ours
+      << "\"]\n    required: false\n"
+         "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+         "  - name: simulator\n    command: [semx-simulator, --world, env1, --clock, lockstep, "
+         "--lockstep-nodes, monitor, --duration, \"3\", --progress, \"0\", --no-rgb]\n"
+         "    ends_set: true\n    start_delay: 1.0\n";
+  std::filesystem::remove(stock);
+  Process logger({stock_bin, "--lcm-url=udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0", stock},
+                 temp_path("stock_logger.out"));
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // subscribed before the set starts
+  const std::string out = temp_path("stock.out");
+  Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--grace", "3"}, out);
+  ASSERT_EQ(launcher.wait(120), 0) << read_file(out);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  logger.signal(SIGINT);
+  ASSERT_EQ(logger.wait(10), 0) << read_file(temp_path("stock_logger.out"));
+
+  std::set<std::pair<std::string, std::string>> recorded;
+  {
+    lcm::LogFile file(stock, "r");
+    ASSERT_TRUE(file.good()) << stock;
+    while (const lcm::LogEvent* ev = file.readNextEvent())
+      recorded.emplace(ev->channel, std::string(static_cast<const char*>(ev->data), ev->datalen));
+  }
+  lcm::LogFile file(ours, "r");
+  ASSERT_TRUE(file.good()) << ours;
+  std::map<std::string, int> held, missing;
+  while (const lcm::LogEvent* ev = file.readNextEvent()) {
+    ++held[ev->channel];
+    if (!recorded.count({ev->channel, std::string(static_cast<const char*>(ev->data), ev->datalen)}))
+      ++missing[ev->channel];
+  }
+  EXPECT_GE(held["CAMERA_DEPTH"], 25) << "3 simulated seconds at 10 Hz";
+  EXPECT_GE(held["SIM_CLOCK"], 300);
+  for (const auto& [channel, n] : missing)
+    ADD_FAILURE() << n << " of the " << held[channel] << " " << channel
+                  << " messages semx-logger recorded are not in "
+                  << "the stock lcm-logger's log";
 }

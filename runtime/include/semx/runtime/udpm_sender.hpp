@@ -7,9 +7,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "semx/runtime/bus_listeners.hpp"
+#include "semx/runtime/bus_pacer.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
 
 namespace semx::runtime {
@@ -29,8 +32,12 @@ uint32_t channel_tag(const std::string& channel);
 
 class UdpmSender {
  public:
-  // Throws std::runtime_error naming the endpoint and the failing call.
-  explicit UdpmSender(const UdpmEndpoint& endpoint);
+  // Throws std::runtime_error naming the endpoint and the failing call. `pace`: every datagram
+  // waits for its turn (bus_pacer.hpp); by default what SEMX_BUS_PACE says, i.e. none.
+  // `foreign_hold_s` > 0: a datagram of 8 KB or more waits, up to that long, until every reader
+  // of the port outside the set (a stock lcm-logger) has room for it (bus_listeners.hpp).
+  explicit UdpmSender(const UdpmEndpoint& endpoint, BusPace pace = bus_pace_from_env(),
+                      double foreign_hold_s = foreign_hold_from_env());
   ~UdpmSender();
   UdpmSender(const UdpmSender&) = delete;
   UdpmSender& operator=(const UdpmSender&) = delete;
@@ -44,6 +51,9 @@ class UdpmSender {
 
  private:
   int fd_ = -1;
+  BusPacer pacer_;
+  std::unique_ptr<BusListeners> listeners_;
+  uint32_t foreign_room_ = 0;
   std::vector<uint8_t> header_;
   uint8_t counter_ = 0;
   uint32_t group_ = 0;  // network order
