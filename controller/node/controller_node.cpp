@@ -14,6 +14,7 @@ ControllerNode::ControllerNode(runtime::NodeOptions options, const ControllerCon
   node_.subscribe<semx::path_t>(
       semx::channels::PLAN_PATH, [this](const semx::path_t& m) { controller_.on_path(to_path(m)); },
       accept_path);
+  node_.judges_non_finite(semx::channels::PLAN_PATH);  // a bad path is answered REJECTED
   const OutsideWindow outside =
       config_.clearance.outside_is_obstacle ? OutsideWindow::kObstacle : OutsideWindow::kFree;
   node_.subscribe<semx::esdf_local_t>(

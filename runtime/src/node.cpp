@@ -513,6 +513,10 @@ void Node::note_handler_error(const std::string& channel, const char* what) {
   }
 }
 
+void Node::judges_non_finite(const std::string& channel) {
+  for (auto& sub : subs_[channel]) sub->finite_only = false;
+}
+
 void Node::note_non_finite_publish(const std::string& channel) {
   ++non_finite_publishes_;
   if (worth_logging(non_finite_publishes_)) {

@@ -129,6 +129,11 @@ class Node {
   template <class T>
   void subscribe(const std::string& channel, std::function<void(const T&)> handler,
                  std::function<bool(const T&)> accept = nullptr);
+  // Messages with a NaN or inf never reach a handler, except on the channels named here, whose
+  // subscribers judge such content themselves and answer it: the controller tells the planner
+  // that a path with a NaN waypoint is REJECTED, so the planner plans again rather than waiting
+  // for a path that never runs.
+  void judges_non_finite(const std::string& channel);
   // Cheap early out for large messages a node only needs some of: a message on `channel` whose
   // utime (every semx type's first field, read straight from the bytes) makes `wanted` false is
   // counted (ChannelCounters::skipped) and dropped before it is validated or decoded. Messages
@@ -316,6 +321,7 @@ class Node {
 
 struct Node::Subscription {
   virtual ~Subscription() = default;
+  bool finite_only = true;  // see judges_non_finite()
   // Returns kMalformed with `why` set when the bytes are not a usable message.
   virtual Outcome deliver(const uint8_t* data, std::size_t size, std::string& why) = 0;
 };
@@ -327,7 +333,7 @@ struct Node::TypedSubscription : Node::Subscription {
   std::function<bool(const T&)> accept;
 
   Outcome deliver(const uint8_t* data, std::size_t size, std::string& why) override {
-    const WireError e = validate_wire(LcmSchema::semx(), *type, T::getHash(), data, size, true);
+    const WireError e = validate_wire(LcmSchema::semx(), *type, T::getHash(), data, size, finite_only);
     if (e != WireError::kNone) {
       why = to_string(e);
       return Outcome::kMalformed;
