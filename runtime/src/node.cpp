@@ -700,7 +700,7 @@ bool Node::may_publish() const {
   return at >= quiet_until_;
 }
 
-void Node::set_time(int64_t utime, int64_t tick) { clock_.on_clock(tick, utime, clock_.mode()); }
+void Node::set_time(int64_t utime, int64_t tick, ClockMode mode) { clock_.on_clock(tick, utime, mode); }
 
 void Node::set_state(NodeState state, const std::string& detail) {
   if (state == state_ && detail == detail_) return;

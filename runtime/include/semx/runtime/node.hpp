@@ -181,8 +181,10 @@ class Node {
   // Publications on ticks this node had promised to be quiet (a broken promise makes a lockstep
   // run depend on scheduling); NODE_STATUS and SIM_ACK do not count.
   int64_t early_publishes() const { return early_publishes_; }
-  // For the clock's source, which does not follow SIM_CLOCK: its own current time.
-  void set_time(int64_t utime, int64_t tick);
+  // For the clock's source, which does not follow SIM_CLOCK: its own current time and mode (the
+  // mode sets how long a lost message is waited for: a lockstep clock source that took itself
+  // for realtime gave up on a lost CONTROL_CMD after 0.3 s, and the run was not valid).
+  void set_time(int64_t utime, int64_t tick, ClockMode mode);
 
   void set_state(NodeState state, const std::string& detail = "");
   NodeState state() const { return state_; }
