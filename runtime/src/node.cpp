@@ -309,7 +309,9 @@ bool Node::named(const Heads& heads, const StreamKey& stream, uint32_t seq) {
 bool Node::may_deliver(const StreamKey& stream, uint32_t seq) const {
   if (stream.sender == signer_.sender()) return true;
   if (!held_ticks_.empty()) return false;  // all of it comes out in its order once the tick is complete
-  if (!in_lockstep() || !acking_senders_.count(stream.sender)) return true;
+  // An observer changes nothing of the run: a recorder writes what comes when it comes, up to
+  // the end (no tick comes after the last one to hand the last messages over).
+  if (!in_lockstep() || options_.observer || !acking_senders_.count(stream.sender)) return true;
   return named(tick_heads_, stream, seq);
 }
 
@@ -477,8 +479,7 @@ void Node::service_delivery() {
   if (!lost.empty()) deliver_ready();
   counters_.recovered = inbox_.counters().recovered;
   while (!held_ticks_.empty() && inbox_.complete()) {
-    // What comes before the tick (its heads name it, its time is before it), then the tick, then
-    // what came after it up to the next held one, each in the order it came.
+    // What the tick names, then the tick; what comes after it waits for the tick that names it.
     const HeldTick tick = held_ticks_.front();
     handle_tick_in_turn(tick.msg, tick.heads, true);
   }

@@ -281,7 +281,8 @@ class Node {
   // "Lost messages"). Without it, a node that lost a SIM_CLOCK tick applied the other nodes'
   // answers to that tick (a new path, an ESDF) before the tick when it came again, and a
   // controller stepped with an ESDF the mapper sent during the tick: another run. Messages of
-  // senders that never ack (tools, a node before its first ack) and all of REALTIME go at once.
+  // senders that never ack (tools, a node before its first ack), all of REALTIME and an
+  // observer's between ticks go at once.
   // Ticks waiting for messages their heads name, with those heads.
   struct HeldTick {
     semx::clock_t msg;
