@@ -181,17 +181,19 @@ bool MapperNode::accept_depth(const semx::depth_image_t& m) {
 }
 
 bool MapperNode::pipelined() const {
-  return mapper_.config().streaming.lockstep_delay > 0 && node_.clock().started() &&
-         node_.clock().mode() == runtime::ClockMode::kLockstep;
+  // A lockstep node's frames before the first tick too: the tick brings their odometry.
+  return mapper_.config().streaming.lockstep_delay > 0 &&
+         (node_.clock().started() ? node_.clock().mode() == runtime::ClockMode::kLockstep
+                                  : node_.clock().participant());
 }
 
 void MapperNode::on_depth(const semx::depth_image_t& m) {
   gate_.taken(m.utime);
   auto job = std::make_shared<Job>();
   job->now = have_time_ ? std::max(now_, m.utime) : m.utime;
-  // Around the vehicle; before the first odometry, around the camera.
-  job->center = vehicle_ ? *vehicle_ : Eigen::Vector3d(decoded_.T_world_optical.translation());
   if (!pipelined()) {
+    // Around the vehicle; before the first odometry, around the camera.
+    job->center = vehicle_ ? *vehicle_ : Eigen::Vector3d(decoded_.T_world_optical.translation());
     std::swap(job->frame, decoded_);  // borrowed: decoded_ keeps its buffer for the next frame
     compute(*job);
     finish(*job);
@@ -200,11 +202,19 @@ void MapperNode::on_depth(const semx::depth_image_t& m) {
     return;
   }
   job->frame = std::move(decoded_);
-  in_flight_.push_back(job);
-  {
+  in_flight_.push_back(job);  // started by the next tick (start_jobs)
+}
+
+void MapperNode::start_jobs() {
+  bool any = false;
+  for (const auto& job : in_flight_) {
+    if (job->started) continue;
+    job->center = vehicle_ ? *vehicle_ : Eigen::Vector3d(job->frame.T_world_optical.translation());
+    job->started = any = true;
     std::lock_guard<std::mutex> lock(mutex_);
     queue_.push_back(job);
   }
+  if (!any) return;
   if (!worker_.joinable()) worker_ = std::thread([this] { worker_loop(); });
   work_cv_.notify_one();
 }
@@ -279,6 +289,7 @@ void MapperNode::worker_loop() {
 }
 
 void MapperNode::publish_done(int64_t up_to_utime) {
+  start_jobs();
   while (!in_flight_.empty() && in_flight_.front()->frame.utime <= up_to_utime) {
     const std::shared_ptr<Job> job = in_flight_.front();
     {
@@ -329,6 +340,7 @@ void MapperNode::on_tick(int64_t tick, int64_t utime) {
   }
   if (!have_time_ || utime > now_) now_ = utime;
   have_time_ = true;
+  start_jobs();
   // A request that came while this node had promised quiet waits for the promised tick.
   const bool answer = request_pending_ && node_.may_publish();
   if (!in_flight_.empty()) {

@@ -126,7 +126,8 @@ class MapperNode {
   struct Job {
     DecodedDepth frame;
     int64_t now = 0;         // node time once the frame is accepted
-    Eigen::Vector3d center;  // ESDF window centre (the latest odometry when the frame came)
+    Eigen::Vector3d center;  // ESDF window centre (the odometry of the frame's tick)
+    bool started = false;    // pipelined: handed to the worker (on the tick after the frame)
     FrameResult result;
     bool esdf = false;  // ESDF_LOCAL goes out with this frame
     bool esdf_recomputed = false;
@@ -141,6 +142,11 @@ class MapperNode {
   void compute(Job& job);  // integrate, ESDF, encode: touches the map, so one thread at a time
   void finish(Job& job);   // counters, log lines, publication
   void publish_done(int64_t up_to_utime);  // in-flight frames with utime <= this, in order
+  // Pipelined: hands the frames that came since the last tick to the worker, centred on the
+  // vehicle's odometry of now. A frame comes right after its tick's odometry; when that odometry
+  // was lost and is sent again, the frame is handled first, and centred on the odometry before,
+  // the ESDF differed from a lossless run's. By the tick, the odometry is held.
+  void start_jobs();
   bool periodic_due() const;
   // LOCKSTEP: the earliest message time of this node's next output (runtime::Node::on_quiet_until).
   int64_t quiet_until(int64_t utime) const;

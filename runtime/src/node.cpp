@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <set>
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_datagram.hpp"
@@ -69,6 +70,12 @@ bool tracked(const std::string& channel) {
 // In lockstep a gap costs only wall time, so it is waited for long (and a recorder wants every
 // message); in realtime a message that comes much later is old news.
 constexpr double kGiveUpLockstepS = 10.0, kGiveUpRealtimeS = 0.3;
+// With no SIM_CLOCK for this long (the clock resends its tick every 50 ms while it waits), the
+// clock is gone: messages waiting for a tick are handed over (a mapper's last request).
+constexpr double kClockGoneS = 3.0;
+// LOCKSTEP ticks lost for good that a node still handles when the next one comes (beyond: it
+// joined late or the clock jumped, and they are not this node's to make up).
+constexpr int64_t kMaxMissedTicks = 100;
 
 AuthKey node_key(const NodeOptions& o) {
   try {
@@ -274,6 +281,7 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
     note_refused(channel, verdict, trailer);
     return;
   }
+  if (channel == channels::SIM_CLOCK) clock_sender_ = trailer.sender;
   const bool in_order = tracked(channel) && trailer.seq != 0;  // seq 0: an observer's (send_signed)
   if (in_order) {
     const StreamKey stream{trailer.sender, channel_tag(channel)};
@@ -294,20 +302,67 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
   deliver_ready();
 }
 
-bool Node::before_held_tick(const StreamKey& stream, uint32_t seq) const {
-  if (held_ticks_.empty()) return true;
-  const auto& heads = held_ticks_.front().heads;
+bool Node::named(const Heads& heads, const StreamKey& stream, uint32_t seq) {
   const auto it = heads.find(stream);
   return it != heads.end() && seq <= it->second;
 }
 
+bool Node::may_deliver(const StreamKey& stream, uint32_t seq) const {
+  if (stream.sender == signer_.sender()) return true;
+  if (!held_ticks_.empty()) return false;  // all of it comes out in its order once the tick is complete
+  // An observer changes nothing of the run: a recorder writes what comes when it comes, up to
+  // the end (no tick comes after the last one to hand the last messages over).
+  if (!in_lockstep() || options_.observer || !acking_senders_.count(stream.sender)) return true;
+  return named(tick_heads_, stream, seq);
+}
+
+bool Node::in_time(const StreamKey& stream, const uint8_t* payload, std::size_t size, int64_t tick_utime) const {
+  if (size < 16) return true;
+  uint64_t u = 0;  // big-endian int64 right after the 8-byte fingerprint: every semx type's utime
+  for (int i = 8; i < 16; ++i) u = (u << 8) | payload[i];
+  const auto utime = static_cast<int64_t>(u);
+  return stream.sender == clock_sender_ ? utime <= tick_utime : utime < tick_utime;
+}
+
 void Node::deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
                            uint32_t seq) {
-  if (stream.sender == signer_.sender() || before_held_tick(stream, seq)) {
+  bool now = may_deliver(stream, seq);
+  for (auto it = deferred_.begin(); now && it != deferred_.end(); ++it) {
+    if (!(it->stream < stream) && !(stream < it->stream)) now = false;  // after its stream's waiting ones
+  }
+  if (now) {
     dispatch(channel, data, size, size - kAuthTrailerBytes);
     return;
   }
   deferred_.push_back({channel, std::vector<uint8_t>(data, data + size), stream, seq});
+}
+
+void Node::release_deferred(const Heads* heads, std::optional<int64_t> before_utime, bool everything) {
+  if (deferred_.empty()) return;
+  std::deque<Inbox::Ready> waiting;
+  waiting.swap(deferred_);
+  std::set<StreamKey> blocked;
+  // The other nodes' answers to the last tick first, then the clock's source's data for the next
+  // one: the clock's source sent its data only once their acks came.
+  for (const bool from_clock : {false, true}) {
+    std::deque<Inbox::Ready> rest;
+    for (auto& d : waiting) {
+      const std::size_t payload = d.bytes.size() - kAuthTrailerBytes;
+      bool go = (d.stream.sender == clock_sender_) == from_clock;
+      if (go && !everything) go = heads ? named(*heads, d.stream, d.seq) : may_deliver(d.stream, d.seq);
+      if (go && !everything && before_utime) go = in_time(d.stream, d.bytes.data(), payload, *before_utime);
+      if (go && !blocked.count(d.stream)) {
+        dispatch(d.channel, d.bytes.data(), d.bytes.size(), payload);
+      } else {
+        if (!go && (d.stream.sender == clock_sender_) == from_clock) blocked.insert(d.stream);
+        rest.push_back(std::move(d));
+      }
+    }
+    waiting.swap(rest);
+  }
+  // What stays, in the order it came, after anything deferred meanwhile.
+  for (auto& d : deferred_) waiting.push_back(std::move(d));
+  deferred_.swap(waiting);
 }
 
 void Node::deliver_ready() {
@@ -364,7 +419,15 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
     });
   }
   semx::clock_t m = msg;
-  if (channel == channels::SIM_CLOCK) {
+  if (channel == channels::SIM_CLOCK && msg.tick == sent_clock_tick_) {
+    // The same tick again: the same heads. Acks that came since name what the nodes sent while
+    // handling this tick, which comes after it; a reader that lost the tick would otherwise take
+    // those messages as coming before it.
+    m.num_heads = sent_clock_.num_heads;
+    m.head_sender = sent_clock_.head_sender;
+    m.head_tag = sent_clock_.head_tag;
+    m.head_seq = sent_clock_.head_seq;
+  } else if (channel == channels::SIM_CLOCK) {
     m.head_sender.clear();
     m.head_tag.clear();
     m.head_seq.clear();
@@ -381,6 +444,8 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
     m.head_sender.resize(static_cast<std::size_t>(m.num_heads));
     m.head_tag.resize(static_cast<std::size_t>(m.num_heads));
     m.head_seq.resize(static_cast<std::size_t>(m.num_heads));
+    sent_clock_ = m;
+    sent_clock_tick_ = m.tick;
   }
   in_publish_clock_ = true;
   const bool ok = publish(channel, m);
@@ -415,20 +480,12 @@ void Node::service_delivery() {
   if (!lost.empty()) deliver_ready();
   counters_.recovered = inbox_.counters().recovered;
   while (!held_ticks_.empty() && inbox_.complete()) {
-    const semx::clock_t tick = std::move(held_ticks_.front().msg);
-    held_ticks_.pop_front();
-    handle_tick(tick);
-    // What came after that tick, up to the next held one (or all of it), in the order it came.
-    std::deque<Inbox::Ready> later;
-    later.swap(deferred_);
-    for (auto& d : later) {
-      if (before_held_tick(d.stream, d.seq)) {
-        dispatch(d.channel, d.bytes.data(), d.bytes.size(), d.bytes.size() - kAuthTrailerBytes);
-      } else {
-        deferred_.push_back(std::move(d));
-      }
-    }
+    // What the tick names, then the tick; what comes after it waits for the tick that names it.
+    const HeldTick tick = held_ticks_.front();
+    handle_tick_in_turn(tick.msg, tick.heads, true);
   }
+  if (held_ticks_.empty() && !deferred_.empty() && last_clock_wall_ >= 0 && now - last_clock_wall_ >= kClockGoneS)
+    release_deferred(nullptr, std::nullopt, true);
 }
 
 void Node::note_refused(const std::string& channel, AuthVerdict verdict, const AuthTrailer& trailer) {
@@ -575,6 +632,7 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
 }
 
 void Node::on_clock_message(const semx::clock_t& msg) {
+  last_clock_wall_ = wall_s();
   // A tick already waiting (the clock sends it again until acked) changes nothing.
   for (const auto& h : held_ticks_) {
     if (h.msg.tick == msg.tick) return;
@@ -586,17 +644,43 @@ void Node::on_clock_message(const semx::clock_t& msg) {
                      static_cast<uint32_t>(msg.head_seq[i])});
   }
   const bool complete = inbox_.tick(heads, wall_s());
+  HeldTick held{msg, {}};
+  for (const StreamHead& h : heads) held.heads[h.stream] = std::max(held.heads[h.stream], h.seq);
   if (!complete || !held_ticks_.empty()) {
-    HeldTick held{msg, {}};
-    for (const StreamHead& h : heads) held.heads[h.stream] = std::max(held.heads[h.stream], h.seq);
     held_ticks_.push_back(std::move(held));
     service_delivery();
     return;
   }
-  handle_tick(msg);
+  handle_tick_in_turn(msg, held.heads, false);
 }
 
-void Node::handle_tick(const semx::clock_t& msg) {
+void Node::handle_tick_in_turn(const semx::clock_t& msg, const Heads& heads, bool held) {
+  const int64_t last = clock_.last_tick();
+  if (msg.mode == semx::clock_t::LOCKSTEP && in_lockstep() && msg.period_us > 0 && msg.tick > last + 1 &&
+      msg.tick - last <= kMaxMissedTicks) {
+    // Ticks this node lost for good (the clock did not wait for it on them, so it did not send
+    // them again): handled now, in turn, as a lossless bus gives them, with what their time puts
+    // before them. Not acked: the clock went on.
+    for (int64_t j = last + 1; j < msg.tick; ++j) {
+      semx::clock_t missed = msg;
+      missed.tick = j;
+      missed.utime = msg.utime - (msg.tick - j) * msg.period_us;
+      release_deferred(&heads, missed.utime);
+      handle_tick(missed, false);
+    }
+  }
+  release_deferred(&heads);
+  if (held) held_ticks_.pop_front();
+  for (const auto& [stream, seq] : heads) {
+    uint32_t& h = tick_heads_[stream];
+    h = std::max(h, seq);
+    acking_senders_.insert(stream.sender);
+  }
+  handle_tick(msg, true);
+  release_deferred(nullptr);
+}
+
+void Node::handle_tick(const semx::clock_t& msg, bool may_ack) {
   const auto decision = clock_.on_clock(msg.tick, msg.utime, static_cast<ClockMode>(msg.mode));
   if (decision.new_tick) {
     if (msg.tick > 0 && msg.utime > 0) tick_period_us_ = msg.utime / msg.tick;
@@ -607,7 +691,7 @@ void Node::handle_tick(const semx::clock_t& msg) {
   const bool skip_ack = decision.new_tick && !decision.reset && quiet_until_ > msg.utime &&
                         last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
                         msg.utime - last_ack_utime_ < kAckIntervalUs;
-  if (decision.ack && !skip_ack) {
+  if (decision.ack && may_ack && !skip_ack) {
     semx::ack_t ack{};
     ack.utime = msg.utime;
     ack.node = options_.name;
@@ -635,7 +719,7 @@ bool Node::may_publish() const {
   return at >= quiet_until_;
 }
 
-void Node::set_time(int64_t utime, int64_t tick) { clock_.on_clock(tick, utime, clock_.mode()); }
+void Node::set_time(int64_t utime, int64_t tick, ClockMode mode) { clock_.on_clock(tick, utime, mode); }
 
 void Node::set_state(NodeState state, const std::string& detail) {
   if (state == state_ && detail == detail_) return;

@@ -170,7 +170,7 @@ void SimulatorNode::publish_clock(const runtime::ClockTick& t) {
   c.mode = static_cast<int8_t>(options_.clock.mode);
   c.speed = options_.clock.mode == runtime::ClockMode::kRealtime ? options_.clock.speed : 0.0;
   c.period_us = options_.clock.period_us;
-  node_.set_time(t.utime, t.tick);
+  node_.set_time(t.utime, t.tick, options_.clock.mode);
   node_.publish(ch::SIM_CLOCK, c);
 }
 

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
         c.mode = static_cast<int8_t>(cfg.mode);
         c.speed = cfg.mode == ClockMode::kRealtime ? cfg.speed : 0.0;
         c.period_us = cfg.period_us;
-        node.set_time(t->utime, t->tick);
+        node.set_time(t->utime, t->tick, cfg.mode);
         node.publish(semx::channels::SIM_CLOCK, c);
         if (!t->resend) warned = false;
       }

@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -185,8 +186,10 @@ class Node {
   // Publications on ticks this node had promised to be quiet (a broken promise makes a lockstep
   // run depend on scheduling); NODE_STATUS and SIM_ACK do not count.
   int64_t early_publishes() const { return early_publishes_; }
-  // For the clock's source, which does not follow SIM_CLOCK: its own current time.
-  void set_time(int64_t utime, int64_t tick);
+  // For the clock's source, which does not follow SIM_CLOCK: its own current time and mode (the
+  // mode sets how long a lost message is waited for: a lockstep clock source that took itself
+  // for realtime gave up on a lost CONTROL_CMD after 0.3 s, and the run was not valid).
+  void set_time(int64_t utime, int64_t tick, ClockMode mode);
 
   void set_state(NodeState state, const std::string& detail = "");
   NodeState state() const { return state_; }
@@ -213,6 +216,7 @@ class Node {
   bool open_session() const { return key_.is_open(); }
 
  private:
+  using Heads = std::map<StreamKey, uint32_t>;  // (sender, channel) -> the last seq published
   struct Subscription;
   template <class T>
   struct TypedSubscription;
@@ -234,8 +238,11 @@ class Node {
   int receive_once(int wait_ms);
   void note_receiver_problems();
   void on_clock_message(const semx::clock_t& msg);
-  // The tick's work and ack, once everything its heads name is held.
-  void handle_tick(const semx::clock_t& msg);
+  // The tick's work and ack (`may_ack`), once everything its heads name is held.
+  void handle_tick(const semx::clock_t& msg, bool may_ack);
+  // The tick in its turn: the LOCKSTEP ticks before it this node lost for good, the messages its
+  // heads name, the tick (first of held_ticks_ when `held`), what may follow it at once.
+  void handle_tick_in_turn(const semx::clock_t& msg, const Heads& heads, bool held);
   // Resend requests, given-up gaps, held ticks whose messages all arrived.
   void service_delivery();
   // Hands a message to the typed subscriptions (`payload` bytes) and raw ones (`size` bytes).
@@ -274,25 +281,50 @@ class Node {
   Inbox inbox_;
   ResendHistory history_;
   std::vector<uint8_t> resend_buffer_;
-  // Ticks waiting for messages their heads name, with those heads. While one waits, messages sent
-  // after it (beyond its heads) wait too: on a lossless bus they would come after the tick, and a
-  // node handles a tick with what it held before (a controller stepped with an ESDF the mapper
-  // sent during that tick, and flew another run).
+  // LOCKSTEP: a message is handed over right before the first tick whose heads name it (the
+  // tick its publisher's next ack led to), so a node handles each tick with the messages a
+  // lossless bus gives it before that tick, whatever the order they came in (docs/runtime.md,
+  // "Lost messages"). Without it, a node that lost a SIM_CLOCK tick applied the other nodes'
+  // answers to that tick (a new path, an ESDF) before the tick when it came again, and a
+  // controller stepped with an ESDF the mapper sent during the tick: another run. Messages of
+  // senders that never ack (tools, a node before its first ack), all of REALTIME and an
+  // observer's between ticks go at once.
+  // Ticks waiting for messages their heads name, with those heads.
   struct HeldTick {
     semx::clock_t msg;
-    std::map<StreamKey, uint32_t> heads;
+    Heads heads;
   };
   std::deque<HeldTick> held_ticks_;
-  std::deque<Inbox::Ready> deferred_;
-  // Hands a message over now, or keeps it until the held tick before it is handled.
+  std::deque<Inbox::Ready> deferred_;  // messages waiting for the tick that names them
+  Heads tick_heads_;                   // the handled ticks' heads
+  std::set<uint64_t> acking_senders_;  // senders a tick's heads named
+  static bool named(const Heads& heads, const StreamKey& stream, uint32_t seq);
+  // True when a message may be handed over before the next tick (own ones, those the next
+  // held tick or the last handled one names, those of senders that do not ack).
+  bool may_deliver(const StreamKey& stream, uint32_t seq) const;
+  // Hands a message over now, or keeps it until the tick that names it.
   void deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
                        uint32_t seq);
-  bool before_held_tick(const StreamKey& stream, uint32_t seq) const;
+  // Hands over the deferred messages that `heads` name (with `before_utime`, only those whose
+  // time puts them before a tick at that utime: in_time), or with no heads those may_deliver()
+  // lets go; each stream in its order, the rest in the order they came. `everything`: all.
+  void release_deferred(const Heads* heads, std::optional<int64_t> before_utime = std::nullopt,
+                        bool everything = false);
+  // For ticks lost for good, whose heads are unknown: the clock's source publishes a tick's
+  // sensor data before the tick (utime <= the tick's), the others what a tick made after it.
+  bool in_time(const StreamKey& stream, const uint8_t* payload, std::size_t size, int64_t tick_utime) const;
+  bool in_lockstep() const {
+    return options_.follow_clock && !clock_source_ && clock_.started() && clock_.mode() == ClockMode::kLockstep;
+  }
+  uint64_t clock_sender_ = 0;    // the clock's source (SIM_CLOCK's signer)
+  double last_clock_wall_ = -1;  // the last SIM_CLOCK heard (a new tick or a resent one)
   struct AckHeads {
     int64_t sender = 0;
     std::vector<std::pair<int32_t, int32_t>> heads;  // (tag, seq)
   };
   std::map<std::string, AckHeads> ack_heads_;  // clock source: each node's latest ack
+  semx::clock_t sent_clock_{};                   // clock source: the last new tick, with its heads
+  int64_t sent_clock_tick_ = -1;
   bool clock_source_ = false;
   bool from_log_ = false;                // file:// provider: a log played back (on_signed_message)
   std::optional<uint64_t> log_session_;  // the one set read from it

@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# A lockstep run on a lossy bus is the run of a lossless one (docs/runtime.md, "Lost messages"):
+# the demo set twice, clean and with every process dropping a share of its datagrams
+# (SEMX_TEST_DROP_RATE), and their metrics.json compared figure by figure.
+#
+#   tests/integration/loss_check.sh [--world env1] [--seed 1] [--time-limit 60] [--drop 0.1]
+#                                   [--drop-seed 3] [--planner semantic-dep] [--out DIR] [--build DIR]
+#
+# Exit 0 when coverage, object coverage, Time_f, Time_r, Time_o, distance, collisions and the
+# termination are equal and the lossy run is valid (no message lost for good); 1 otherwise. Also
+# checks that each process of the lossy run asked for messages again (SIM_RESEND in run.lcmlog):
+# the drop reached it. Runs in a private network namespace when it can (as root), so no other
+# set hears it; otherwise the launcher's bus claim gives the set a port of its own.
+set -uo pipefail
+ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
+world=env1 seed=1 time_limit=60 drop=0.1 drop_seed=3 planner=semantic-dep out="" build="$ROOT/build"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --world) world=$2; shift 2 ;;
+    --seed) seed=$2; shift 2 ;;
+    --time-limit) time_limit=$2; shift 2 ;;
+    --drop) drop=$2; shift 2 ;;
+    --drop-seed) drop_seed=$2; shift 2 ;;
+    --planner) planner=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --build) build=$2; shift 2 ;;
+    --in-netns) in_netns=1; shift ;;
+    *) echo "loss_check: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+[ -n "$out" ] || out=$(mktemp -d /tmp/loss-check.XXXXXX)
+mkdir -p "$out"
+if [ -z "${in_netns:-}" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
+  exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@" --in-netns' \
+    "$0" --world "$world" --seed "$seed" --time-limit "$time_limit" --drop "$drop" --drop-seed "$drop_seed" \
+    --planner "$planner" --out "$out" --build "$build"
+fi
+launch="$build/bin/semx-launch"
+[ -x "$launch" ] || { echo "loss_check: no $launch (build first)" >&2; exit 2; }
+
+json() {  # json FILE KEY: a scalar of metrics.json
+  sed -n "s/^  \"$2\": \\(.*\\),\$/\\1/p" "$1" | tr -d '"'
+}
+
+run() {  # run NAME [ENV=VALUE ...]
+  local name=$1 dir="$out/$1"
+  shift
+  rm -rf "$dir"
+  env "$@" "$launch" demo --no-color --arg "world=$world" --arg "seed=$seed" --arg "planner=$planner" \
+    --arg "time_limit=$time_limit" --arg "out=$dir" >"$dir.console" 2>&1
+  echo $? >"$dir.rc"
+}
+
+run clean
+run lossy SEMX_TEST_DROP_RATE="$drop" SEMX_TEST_DROP_SEED="$drop_seed"
+
+failed=0
+keys="coverage_pct object_coverage_pct time_f_s time_r_s time_o_s distance_m collisions termination"
+printf '%-20s %16s %16s %s\n' figure clean "lossy ($drop)" check
+for k in $keys valid wall_s; do
+  a=$(json "$out/clean/metrics.json" "$k" 2>/dev/null) b=$(json "$out/lossy/metrics.json" "$k" 2>/dev/null)
+  check=ok
+  case "$k" in
+    wall_s) check="-" ;;
+    valid) [ "$b" = true ] || { check="lossy run not valid"; failed=1; } ;;
+    *) [ -n "$a" ] && [ "$a" = "$b" ] || { check=DIFFERENT; failed=1; } ;;
+  esac
+  printf '%-20s %16s %16s %s\n' "$k" "${a:--}" "${b:--}" "$check"
+done
+for r in clean lossy; do
+  [ "$(cat "$out/$r.rc")" = 0 ] || { echo "loss_check: the $r run exited with $(cat "$out/$r.rc")"; failed=1; }
+done
+# Who asked for messages again: every process that lost some (resend_t: utime, then the node's name).
+python3 - "$out/lossy/run.lcmlog" <<'EOF' || failed=1
+import collections, struct, sys
+asked = collections.Counter()
+data = open(sys.argv[1], 'rb').read()
+pos = 0
+while pos + 28 <= len(data):
+    sync, _, _, cl, dl = struct.unpack('>IqqII', data[pos:pos + 28])
+    if sync != 0xEDA1DA01:
+        break
+    ch = data[pos + 28:pos + 28 + cl].decode()
+    p = data[pos + 28 + cl:pos + 28 + cl + dl]
+    pos += 28 + cl + dl
+    if ch == 'SIM_RESEND' and len(p) >= 20:
+        n = struct.unpack('>i', p[16:20])[0]
+        asked[p[20:20 + n - 1].decode(errors='replace')] += 1
+print('SIM_RESEND requests in the lossy run:', ', '.join('%s %d' % kv for kv in sorted(asked.items())))
+missing = {'simulator', 'mapper', 'semantics', 'planner', 'controller', 'evaluator'} - set(asked)
+if missing:
+    print('loss_check: never asked for a message again (did the drop reach them?):', ', '.join(sorted(missing)))
+    sys.exit(1)
+EOF
+echo "runs in $out"
+exit $failed
