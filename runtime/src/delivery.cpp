@@ -42,10 +42,8 @@ void Inbox::release(const StreamKey& key, Stream& st) {
     ready_.push_back({std::move(it->second.channel), std::move(it->second.bytes), key, it->first});
     ++st.next;
   }
-  if (!missing(st)) {
-    st.gap_since = -1;
-    st.last_request = -1;
-  }
+  if (!missing(st)) st.gap_since = -1;
+  if (!asking(st)) st.last_request = -1;
 }
 
 bool Inbox::tick(const std::vector<StreamHead>& heads, double now) {
@@ -66,6 +64,20 @@ bool Inbox::tick(const std::vector<StreamHead>& heads, double now) {
   return complete();
 }
 
+void Inbox::hint(const StreamKey& s, uint32_t seq) {
+  if (s.sender == self_ || !tags_.count(s.tag) || seq == 0) return;
+  auto it = streams_.find(s);
+  if (it == streams_.end()) {
+    // Not from a stranger's lie a new stream: the caller names only senders it verified.
+    if (!o_.from_start || seq > kMaxHintAhead) return;
+    it = streams_.emplace(s, Stream{}).first;
+    it->second.next = 1;
+  }
+  Stream& st = it->second;
+  if (st.next == 0 || seq < st.next || seq > std::max(st.want, st.next) + kMaxHintAhead) return;
+  st.hinted = std::max(st.hinted, seq);
+}
+
 bool Inbox::complete() const {
   for (const auto& [key, st] : streams_) {
     if (missing(st)) return false;
@@ -76,7 +88,8 @@ bool Inbox::complete() const {
 std::vector<ResendRequest> Inbox::requests(double now) {
   std::vector<ResendRequest> out;
   for (auto& [key, st] : streams_) {
-    if (!missing(st)) continue;
+    if (!asking(st)) continue;
+    const uint32_t want = std::max(st.want, st.hinted);
     // Runs not asked for yet go out at once; runs asked for already, again every retry_s (the
     // answer may be on its way). Every run of the stream, or a busy stream falls further behind
     // than its publisher keeps.
@@ -84,14 +97,14 @@ std::vector<ResendRequest> Inbox::requests(double now) {
     bool any = false;
     uint32_t seq = st.next;
     auto held = st.held.begin();
-    for (int runs = 0; seq <= st.want && runs < 32; ++runs) {
+    for (int runs = 0; seq <= want && runs < 32; ++runs) {
       while (held != st.held.end() && held->first < seq) ++held;
       while (held != st.held.end() && held->first == seq) {
         ++seq;
         ++held;
       }
-      if (seq > st.want) break;
-      const uint32_t last = held == st.held.end() ? st.want : std::min(st.want, held->first - 1);
+      if (seq > want) break;
+      const uint32_t last = held == st.held.end() ? want : std::min(want, held->first - 1);
       if (retry || last > st.asked) {
         out.push_back({key, retry ? seq : std::max(seq, st.asked + 1), last});
         ++counters_.requests;
@@ -100,7 +113,7 @@ std::vector<ResendRequest> Inbox::requests(double now) {
       seq = last + 1;
     }
     if (any && retry) st.last_request = now;
-    st.asked = std::max(st.asked, st.want);
+    st.asked = std::max(st.asked, want);
   }
   return out;
 }
@@ -130,6 +143,16 @@ std::vector<ResendRequest> Inbox::give_up(double now) {
   return lost;
 }
 
+Inbox::Resent Inbox::resent(const StreamKey& s, uint32_t seq) {
+  const auto it = streams_.find(s);
+  if (it == streams_.end() || it->second.next == 0) return Resent::kUnknown;
+  if (seq < it->second.next || it->second.held.count(seq)) {
+    ++counters_.duplicates;
+    return Resent::kDuplicate;
+  }
+  return Resent::kAwaited;
+}
+
 bool Inbox::ready(Ready* out) {
   if (ready_.empty()) return false;
   *out = std::move(ready_.front());
@@ -138,12 +161,12 @@ bool Inbox::ready(Ready* out) {
 }
 
 std::vector<uint8_t> ResendHistory::keep(const std::string& channel, uint32_t tag, uint32_t seq,
-                                         std::vector<uint8_t>&& bytes) {
+                                         std::vector<uint8_t>&& bytes, uint32_t wire_seqno) {
   Channel& c = channels_[tag];
   if (c.name.empty()) c.name = channel;
   c.bytes += bytes.size();
   total_bytes_ += bytes.size();
-  c.kept.push_back({seq, std::move(bytes)});
+  c.kept.push_back({seq, std::move(bytes), wire_seqno});
   std::vector<uint8_t> reuse;
   while (c.kept.size() > 1 && (c.kept.size() > per_channel_ || c.bytes > bytes_per_channel_)) {
     c.bytes -= c.kept.front().bytes.size();
@@ -155,7 +178,8 @@ std::vector<uint8_t> ResendHistory::keep(const std::string& channel, uint32_t ta
   return reuse;
 }
 
-const std::vector<uint8_t>* ResendHistory::find(uint32_t tag, uint32_t seq, const std::string** channel) const {
+const std::vector<uint8_t>* ResendHistory::find(uint32_t tag, uint32_t seq, const std::string** channel,
+                                                uint32_t* wire_seqno) const {
   const auto it = channels_.find(tag);
   if (it == channels_.end() || it->second.kept.empty()) return nullptr;
   const auto& kept = it->second.kept;
@@ -163,6 +187,7 @@ const std::vector<uint8_t>* ResendHistory::find(uint32_t tag, uint32_t seq, cons
   const uint32_t first = kept.front().seq;
   if (seq < first || seq - first >= kept.size() || kept[seq - first].seq != seq) return nullptr;
   if (channel) *channel = &it->second.name;
+  if (wire_seqno) *wire_seqno = kept[seq - first].wire_seqno;
   return &kept[seq - first].bytes;
 }
 

@@ -44,22 +44,49 @@ LcmReassembler::LcmReassembler(std::size_t max_message_bytes)
     : max_message_bytes_(max_message_bytes),
       pending_budget_(std::max<std::size_t>(2 * max_message_bytes, 64u << 20)) {}
 
-void LcmReassembler::make_room(std::size_t bytes, uint64_t keep, bool adding) {
-  while (pending_bytes_ + bytes > pending_budget_ || (adding && pending_.size() >= kMaxPendingSenders)) {
-    auto oldest = pending_.end();
-    for (auto it = pending_.begin(); it != pending_.end(); ++it) {
-      if (it->first != keep && (oldest == pending_.end() || it->second.started < oldest->second.started))
-        oldest = it;
+void LcmReassembler::abandon(std::map<Key, Pending>::iterator it) {
+  pending_bytes_ -= it->second.data.size();
+  pending_.erase(it);
+  ++counters_.incomplete;
+}
+
+void LcmReassembler::make_room(std::size_t bytes, uint64_t sender) {
+  auto oldest_of = [&](bool this_sender) {
+    auto best = pending_.end();
+    auto it = this_sender ? pending_.lower_bound(Key{sender, 0}) : pending_.begin();
+    std::size_t n = 0;
+    for (; it != pending_.end() && (!this_sender || it->first.sender == sender); ++it, ++n) {
+      if (best == pending_.end() || it->second.started < best->second.started) best = it;
     }
-    if (oldest == pending_.end()) return;
-    pending_bytes_ -= oldest->second.data.size();
-    pending_.erase(oldest);
-    ++counters_.incomplete;
+    return std::make_pair(best, n);
+  };
+  for (;;) {
+    const auto [oldest, n] = oldest_of(true);
+    if (n < kMaxPendingPerSender) break;
+    abandon(oldest);
   }
+  while (!pending_.empty() && (pending_bytes_ + bytes > pending_budget_ || pending_.size() >= kMaxPending))
+    abandon(oldest_of(false).first);
+}
+
+bool LcmReassembler::recently_done(const Key& key, uint32_t size, double now_s) {
+  std::size_t expired = 0;
+  while (expired < done_recent_.size() && now_s - done_recent_[expired].at > kDoneMemoryS) ++expired;
+  done_recent_.erase(done_recent_.begin(), done_recent_.begin() + static_cast<std::ptrdiff_t>(expired));
+  for (const Done& d : done_recent_)
+    if (d.key == key && d.size == size) return true;
+  return false;
+}
+
+bool LcmReassembler::next_tail(Tail* out) {
+  if (tails_.empty()) return false;
+  *out = std::move(tails_.front());
+  tails_.pop_front();
+  return true;
 }
 
 DatagramError LcmReassembler::feed(uint64_t sender, const uint8_t* data, std::size_t size,
-                                   LcmMessageView* out, bool* complete) {
+                                   LcmMessageView* out, bool* complete, double now_s) {
   ++counters_.datagrams;
   *complete = false;
   DatagramError e = DatagramError::kNone;
@@ -83,8 +110,8 @@ DatagramError LcmReassembler::feed(uint64_t sender, const uint8_t* data, std::si
         *complete = true;
       }
     }
-  } else if (be32(data) == kLcmMagicLong) {
-    e = feed_fragment(sender, data, size, out, complete);
+  } else if (be32(data) == kLcmMagicLong || be32(data) == kSemxMagicResend) {
+    e = feed_fragment(sender, data, size, out, complete, be32(data) == kSemxMagicResend, now_s);
   } else {
     e = DatagramError::kMagic;
   }
@@ -93,7 +120,7 @@ DatagramError LcmReassembler::feed(uint64_t sender, const uint8_t* data, std::si
 }
 
 DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data, std::size_t size,
-                                            LcmMessageView* out, bool* complete) {
+                                            LcmMessageView* out, bool* complete, bool resend, double now_s) {
   if (size < kLcmLongHeader) return DatagramError::kTooShort;
   const uint32_t seqno = be32(data + 4);
   const uint32_t msg_size = be32(data + 8);
@@ -104,46 +131,88 @@ DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data
   if (msg_size > max_message_bytes_) return DatagramError::kTooLarge;
 
   std::size_t at = kLcmLongHeader;
-  auto it = pending_.find(sender);
+  int name_len = 0;
   if (number == 0) {
-    const int len = lcm_channel_length(data + at, size - at);
-    if (len < 0) return DatagramError::kChannel;
+    name_len = lcm_channel_length(data + at, size - at);
+    if (name_len < 0) return DatagramError::kChannel;
     if (offset != 0) return DatagramError::kFragment;
-    at += static_cast<std::size_t>(len) + 1;
-    if (size - at > msg_size) return DatagramError::kFragment;
-    if (it != pending_.end()) {
-      ++counters_.incomplete;  // the sender moved on: what is missing will not come
-      pending_bytes_ -= it->second.data.size();
-      it->second.data.clear();
+    at += static_cast<std::size_t>(name_len) + 1;
+  }
+  const std::size_t n = size - at;
+  if (offset > msg_size || n > msg_size - offset) return DatagramError::kFragment;
+
+  const Key key{sender, seqno};
+  auto it = pending_.find(key);
+  if (it != pending_.end()) {
+    const Pending& p = it->second;
+    const bool stale = now_s > 0 && now_s - p.created_s > kPendingMaxAgeS;
+    const bool other = p.size != msg_size || p.count != count;
+    // The sender's counter came round, or a first fragment starts another message under a seqno
+    // still held: the old one will not be finished.
+    if (stale || (other && number == 0 && !resend)) {
+      abandon(it);
+      it = pending_.end();
+    } else if (other) {
+      return DatagramError::kFragment;
     }
-    make_room(msg_size, sender, it == pending_.end());
-    if (it == pending_.end()) it = pending_.emplace(sender, Pending{}).first;
+  }
+  if (it == pending_.end()) {
+    if (resend && recently_done(key, msg_size, now_s)) {
+      ++counters_.spare;  // the rest of a copy that came after the message was whole
+      return DatagramError::kNone;
+    }
+    if (number != 0 && !resend && !seqno_tagged(seqno)) {
+      // The first fragment was filtered out (a channel nobody here reads) or lost.
+      ++counters_.orphans;
+      return DatagramError::kNone;
+    }
+    if (number == 0 && !resend) {  // a new message under this seqno: not the one completed before
+      done_recent_.erase(std::remove_if(done_recent_.begin(), done_recent_.end(),
+                                        [&](const Done& d) { return d.key == key; }),
+                         done_recent_.end());
+    }
+    make_room(msg_size, sender);
+    it = pending_.emplace(key, Pending{}).first;
     Pending& p = it->second;
     p.started = ++started_;
-    p.seqno = seqno;
+    p.created_s = now_s;
     p.size = msg_size;
+    p.count = count;
     p.remaining = count;
     p.seen.assign(count, false);
-    p.channel.assign(reinterpret_cast<const char*>(data + kLcmLongHeader), static_cast<std::size_t>(len));
     p.data.resize(msg_size);
     pending_bytes_ += msg_size;
-  } else if (it == pending_.end() || it->second.seqno != seqno) {
-    // The first fragment was filtered out (a channel nobody here reads) or lost.
-    ++counters_.orphans;
-    return DatagramError::kNone;
   }
   Pending& p = it->second;
-  const std::size_t n = size - at;
-  if (p.seen.size() != count || p.seen[number] || offset > p.size || n > p.size - offset) {
-    return DatagramError::kFragment;
+  if (p.seen[number]) {
+    if (resend) {
+      ++counters_.spare;
+      return DatagramError::kNone;
+    }
+    return DatagramError::kFragment;  // the same original fragment twice
   }
   if (n) std::memcpy(p.data.data() + offset, data + at, n);
+  if (number == 0) p.channel.assign(reinterpret_cast<const char*>(data + kLcmLongHeader), static_cast<std::size_t>(name_len));
   p.seen[number] = true;
-  if (--p.remaining > 0) return DatagramError::kNone;
+  p.resent = p.resent || resend;
+  if (--p.remaining > 0) {
+    // The message's last bytes came and it is still incomplete: say so once, so the reader can
+    // ask for it before any later message of its channel comes whole (at 10 % loss a 1 MB
+    // message seldom does).
+    if (tail_bytes_ > 0 && !p.tail_told && number + 1u == count && msg_size - offset >= tail_bytes_ &&
+        msg_size >= tail_bytes_ && tails_.size() < kMaxTails) {
+      p.tail_told = true;
+      tails_.push_back({sender, seqno, std::vector<uint8_t>(p.data.end() - static_cast<std::ptrdiff_t>(tail_bytes_), p.data.end())});
+    }
+    return DatagramError::kNone;
+  }
+  if (p.resent) ++counters_.filled;
   pending_bytes_ -= p.data.size();
   done_.swap(p.data);
   channel_.swap(p.channel);
   pending_.erase(it);
+  if (done_recent_.size() >= 256) done_recent_.erase(done_recent_.begin());
+  done_recent_.push_back({key, msg_size, now_s});
   out->channel = &channel_;
   out->data = done_.data();
   out->size = done_.size();

@@ -291,4 +291,15 @@ AuthVerdict MessageVerifier::verify(const std::string& channel, const uint8_t* d
   return AuthVerdict::kOk;
 }
 
+bool MessageVerifier::authentic(const std::string& channel, const uint8_t* data, std::size_t size) {
+  const auto a = read_trailer(data, size);
+  if (!a || a->session != session_) return false;
+  const auto it = senders_.find(a->sender);
+  const std::array<uint8_t, 32> key = it != senders_.end() ? it->second.key : key_.sender_key(a->sender);
+  const std::size_t payload = size - kAuthTrailerBytes;
+  const uint8_t* t = data + payload;
+  uint8_t tag[kTagBytes];
+  return cipher_->tag(key, channel, data, payload, t, tag) && CRYPTO_memcmp(tag, t + kOffTag, kTagBytes) == 0;
+}
+
 }  // namespace semx::runtime

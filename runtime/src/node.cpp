@@ -188,11 +188,18 @@ void Node::update_receiver() {
   try {
     if (!receiver_) {
       receiver_ = std::make_unique<UdpmReceiver>(*udpm_, options_.max_message_bytes);
+      if (options_.sign) receiver_->report_tails(kAuthTrailerBytes);
       if (const char* rate = std::getenv("SEMX_TEST_DROP_RATE"); rate && *rate) {
         // A lossy bus for tests and experiments: this node loses that share of its datagrams.
         const char* seed = std::getenv("SEMX_TEST_DROP_SEED");
         receiver_->drop_for_test(std::atof(rate),
                                  std::hash<std::string>{}(options_.name) ^ (seed ? std::strtoull(seed, nullptr, 10) : 0));
+      }
+      if (const char* ms = std::getenv("SEMX_TEST_JITTER_MS"); ms && *ms) {
+        // A bus with jitter: this node's datagrams each come up to that late, out of order.
+        const char* seed = std::getenv("SEMX_TEST_DROP_SEED");
+        receiver_->delay_for_test(std::atof(ms) / 1000.0, std::hash<std::string>{}(options_.name) ^
+                                                              (seed ? std::strtoull(seed, nullptr, 10) : 0) ^ 0x6a09e667u);
       }
       if (receiver_->granted_recv_buf() < receiver_->requested_recv_buf()) {
         throw NodeError("the LCM URL asks for a " + std::to_string(receiver_->requested_recv_buf()) +
@@ -277,7 +284,21 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
   }
   AuthTrailer trailer;
   const AuthVerdict verdict = verifier_.verify(channel, data, size, &trailer);
-  if (verdict != AuthVerdict::kOk) {
+  if (verdict == AuthVerdict::kReplayed && tracked(channel) && trailer.seq != 0) {
+    // A publisher's resend is the message as first sent, counter and all: a duplicate for a
+    // reader that had it, the message itself for one that lost it.
+    switch (inbox_.resent({trailer.sender, channel_tag(channel)}, trailer.seq)) {
+      case Inbox::Resent::kDuplicate:
+        return;
+      case Inbox::Resent::kAwaited:
+        if (verifier_.authentic(channel, data, size)) break;
+        note_refused(channel, AuthVerdict::kForged, trailer);
+        return;
+      case Inbox::Resent::kUnknown:
+        note_refused(channel, verdict, trailer);
+        return;
+    }
+  } else if (verdict != AuthVerdict::kOk) {
     note_refused(channel, verdict, trailer);
     return;
   }
@@ -382,13 +403,20 @@ void Node::on_resend_request(const semx::resend_t& r) {
   const uint32_t last = std::min<uint32_t>(static_cast<uint32_t>(r.last_seq), first + 255);
   for (uint32_t seq = first; seq <= last; ++seq) {
     const std::string* channel = nullptr;
-    const std::vector<uint8_t>* kept = history_.find(static_cast<uint32_t>(r.channel_tag), seq, &channel);
+    uint32_t wire_seqno = 0;
+    const std::vector<uint8_t>* kept =
+        history_.find(static_cast<uint32_t>(r.channel_tag), seq, &channel, &wire_seqno);
     if (!kept) continue;
-    resend_buffer_.assign(kept->begin(), kept->end() - static_cast<std::ptrdiff_t>(kAuthTrailerBytes));
-    signer_.sign_as(*channel, resend_buffer_, seq);
-    const bool sent = sender_ ? sender_->publish(*channel, resend_buffer_.data(), resend_buffer_.size())
-                              : lcm_->publish(*channel, resend_buffer_.data(),
-                                              static_cast<unsigned int>(resend_buffer_.size())) == 0;
+    bool sent = false;
+    if (sender_) {
+      // The bytes as first sent, under their first seqno: a reader that lost one fragment of a
+      // 1 MB frame needs only that fragment from this copy (lcm_datagram.hpp, SXR3).
+      sent = sender_->publish_again(*channel, kept->data(), kept->size(), wire_seqno);
+    } else {
+      resend_buffer_.assign(kept->begin(), kept->end() - static_cast<std::ptrdiff_t>(kAuthTrailerBytes));
+      signer_.sign_as(*channel, resend_buffer_, seq);
+      sent = lcm_->publish(*channel, resend_buffer_.data(), static_cast<unsigned int>(resend_buffer_.size())) == 0;
+    }
     if (sent) ++counters_.resent;
   }
 }
@@ -610,14 +638,15 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
   }
   auto& c = outgoing_[channel];
   c.outgoing = true;
-  const bool sent = sender_ ? sender_->publish(channel, data, size)
+  uint32_t wire_seqno = 0;
+  const bool sent = sender_ ? sender_->publish(channel, data, size, &wire_seqno)
                             : lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
   if (!sent) {
     ++c.dropped;
     ++counters_.dropped;
     // Kept all the same: its sequence number is spent, and a reader will ask for it.
     if (options_.sign && tracked(channel) && trailer.seq != 0)
-      bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
+      bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes), wire_seqno);
     return false;
   }
   ++c.messages;
@@ -626,7 +655,7 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
   ++counters_.sent;
   // Kept for a reader that lost it; the buffer handed back is reused by the next message.
   if (options_.sign && tracked(channel) && trailer.seq != 0) {
-    bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes));
+    bytes = history_.keep(channel, channel_tag(channel), trailer.seq, std::move(bytes), wire_seqno);
   }
   return true;
 }
@@ -805,6 +834,14 @@ int Node::receive_once(int wait_ms) {
   bool got = receiver_->next(&m);
   if (!got && wait_ms > 0 && receiver_->wait(wait_ms)) got = receiver_->next(&m);
   note_receiver_problems();
+  LcmReassembler::Tail tail;
+  while (receiver_->next_tail(&tail)) {
+    // An incomplete message's trailer (unverified: it is only a hint) names its stream and seq,
+    // so the node asks for it now instead of when a later message of the channel comes whole.
+    const auto t = read_trailer(tail.bytes.data(), tail.bytes.size());
+    if (!t || t->session != verifier_.session() || !verifier_.knows(t->sender) || !seqno_tagged(tail.seqno)) continue;
+    inbox_.hint({t->sender, (tail.seqno >> kSeqnoTagShift) & kSeqnoTagBits}, t->seq);
+  }
   if (!got) return 0;
   // liblcm calls a channel's handlers in the order they subscribed; the typed subscription of a
   // channel comes before any pattern here (SIM_CLOCK is subscribed in the constructor).

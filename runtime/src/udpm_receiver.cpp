@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -128,7 +130,7 @@ std::vector<sock_filter> lcm_channel_filter(const std::vector<std::string>& chan
   tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
 
   std::vector<sock_filter> prog;
-  const uint32_t names_at = 11;
+  const uint32_t names_at = 14;
   const uint32_t tags_at = names_at + static_cast<uint32_t>(names.size()) + 1;
   prog.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, payload));  // 0: magic
   prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kLcmMagicShort, 0, 2));
@@ -136,12 +138,16 @@ std::vector<sock_filter> lcm_channel_filter(const std::vector<std::string>& chan
   prog.push_back(BPF_JUMP(BPF_JMP | BPF_JA, names_at - 4, 0, 0));
   prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kLcmMagicLong, 0, 4));  // 4: else to 9
   prog.push_back(BPF_STMT(BPF_LD | BPF_H | BPF_ABS, payload + 16));          // fragment number
-  prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, 0, 3, 0));              // the first: to 10
+  prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, 0, 6, 0));              // the first: to 13
   prog.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, payload + 4));           // 7: a later one's seqno
   prog.push_back(BPF_JUMP(BPF_JMP | BPF_JA, tags_at - 9, 0, 0));
-  prog.push_back(BPF_STMT(BPF_RET | BPF_K, 0));  // 9: not LCM's
+  // 9: a fragment sent again (every one of them, the first too) is judged by its tag.
+  prog.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kSemxMagicResend, 0, 2));
+  prog.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, payload + 4));
+  prog.push_back(BPF_JUMP(BPF_JMP | BPF_JA, tags_at - 12, 0, 0));
+  prog.push_back(BPF_STMT(BPF_RET | BPF_K, 0));  // 12: not LCM's
   prog.push_back(BPF_STMT(BPF_LDX | BPF_W | BPF_IMM, payload + static_cast<uint32_t>(kLcmLongHeader)));
-  prog.insert(prog.end(), names.begin(), names.end());  // 11: each block returns on a match
+  prog.insert(prog.end(), names.begin(), names.end());  // 14: each block returns on a match
   prog.push_back(BPF_STMT(BPF_RET | BPF_K, unlisted));
   // tags_at: A = seqno. Untagged (another sender) passes; a tag is judged like a name.
   prog.push_back(BPF_STMT(BPF_ST, 0));
@@ -218,39 +224,88 @@ void UdpmReceiver::filter(const std::vector<std::string>& channels, bool all,
   }
 }
 
-bool UdpmReceiver::next(LcmMessageView* out) {
+namespace {
+double monotonic_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+uint64_t xorshift(uint64_t& state) {  // a test's own, repeatable draws
+  state ^= state << 13;
+  state ^= state >> 7;
+  state ^= state << 17;
+  return state;
+}
+}  // namespace
+
+bool UdpmReceiver::drop_now() {
+  if (drop_rate_ <= 0) return false;
+  if (static_cast<double>(xorshift(drop_state_) >> 11) * 0x1.0p-53 >= drop_rate_) return false;
+  ++dropped_for_test_;
+  return true;
+}
+
+bool UdpmReceiver::read_datagram(std::size_t* n, uint64_t* sender) {
   for (;;) {
     sockaddr_in from{};
     socklen_t from_len = sizeof from;
-    const ssize_t n = ::recvfrom(fd_, buffer_.data(), buffer_.size(), MSG_DONTWAIT | MSG_TRUNC,
-                                 reinterpret_cast<sockaddr*>(&from), &from_len);
-    if (n < 0) {
+    const ssize_t got = ::recvfrom(fd_, buffer_.data(), buffer_.size(), MSG_DONTWAIT | MSG_TRUNC,
+                                   reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (got < 0) {
       if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) ++socket_errors_;
       return false;
     }
-    if (drop_rate_ > 0) {
-      drop_state_ ^= drop_state_ << 13;  // xorshift64: a test's own, repeatable draws
-      drop_state_ ^= drop_state_ >> 7;
-      drop_state_ ^= drop_state_ << 17;
-      if (static_cast<double>(drop_state_ >> 11) * 0x1.0p-53 < drop_rate_) {
-        ++dropped_for_test_;
-        continue;
-      }
-    }
-    if (static_cast<std::size_t>(n) > buffer_.size()) {  // MSG_TRUNC: longer than any UDP payload
+    if (drop_now()) continue;
+    if (static_cast<std::size_t>(got) > buffer_.size()) {  // MSG_TRUNC: longer than any UDP payload
       last_error_ = DatagramError::kTooLarge;
       continue;
     }
-    const uint64_t sender = (uint64_t{ntohl(from.sin_addr.s_addr)} << 16) | ntohs(from.sin_port);
-    bool complete = false;
-    const DatagramError e =
-        reassembler_.feed(sender, buffer_.data(), static_cast<std::size_t>(n), out, &complete);
-    if (e != DatagramError::kNone) last_error_ = e;
-    if (complete) return true;
+    *n = static_cast<std::size_t>(got);
+    *sender = (uint64_t{ntohl(from.sin_addr.s_addr)} << 16) | ntohs(from.sin_port);
+    return true;
   }
 }
 
+bool UdpmReceiver::next(LcmMessageView* out) {
+  if (delay_max_s_ > 0) return next_delayed(out);
+  std::size_t n = 0;
+  uint64_t sender = 0;
+  while (read_datagram(&n, &sender)) {
+    bool complete = false;
+    const DatagramError e = reassembler_.feed(sender, buffer_.data(), n, out, &complete, monotonic_s());
+    if (e != DatagramError::kNone) last_error_ = e;
+    if (complete) return true;
+  }
+  return false;
+}
+
+bool UdpmReceiver::next_delayed(LcmMessageView* out) {
+  const double now = monotonic_s();
+  std::size_t n = 0;
+  uint64_t sender = 0;
+  while (read_datagram(&n, &sender)) {
+    const double u = static_cast<double>(xorshift(delay_state_) >> 11) * 0x1.0p-53;
+    delayed_.push({now + u * delay_max_s_, delay_order_++, sender, std::vector<uint8_t>(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(n))});
+  }
+  while (!delayed_.empty() && delayed_.top().due <= now) {
+    // priority_queue's top is const: the bytes are moved out through a cast, then popped.
+    current_ = std::move(const_cast<Delayed&>(delayed_.top()).bytes);
+    const uint64_t from = delayed_.top().sender;
+    delayed_.pop();
+    bool complete = false;
+    const DatagramError e = reassembler_.feed(from, current_.data(), current_.size(), out, &complete, now);
+    if (e != DatagramError::kNone) last_error_ = e;
+    if (complete) return true;
+  }
+  return false;
+}
+
 bool UdpmReceiver::wait(int timeout_ms) const {
+  if (!delayed_.empty()) {
+    const double until_due = delayed_.top().due - monotonic_s();
+    if (until_due <= 0) return true;
+    timeout_ms = std::min(timeout_ms, static_cast<int>(std::ceil(until_due * 1000)));
+    pollfd p{fd_, POLLIN, 0};
+    return ::poll(&p, 1, timeout_ms) > 0 || delayed_.top().due <= monotonic_s();
+  }
   pollfd p{fd_, POLLIN, 0};
   return ::poll(&p, 1, timeout_ms) > 0;
 }

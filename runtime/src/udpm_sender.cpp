@@ -74,10 +74,24 @@ UdpmSender::~UdpmSender() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::size_t size) {
+bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t* seqno_out) {
   if (channel.empty() || channel.size() > kLcmMaxChannel || channel.find('\0') != std::string::npos)
     return false;
   const uint32_t seqno = kSeqnoTagged | (channel_tag(channel) << kSeqnoTagShift) | counter_++;
+  if (seqno_out) *seqno_out = seqno;
+  return send_message(channel, data, size, seqno, kLcmMagicLong);
+}
+
+bool UdpmSender::publish_again(const std::string& channel, const uint8_t* data, std::size_t size,
+                               uint32_t seqno) {
+  if (channel.empty() || channel.size() > kLcmMaxChannel || channel.find('\0') != std::string::npos)
+    return false;
+  if (kLcmShortHeader + channel.size() + 1 + size <= kMaxDatagram) return publish(channel, data, size);
+  return send_message(channel, data, size, seqno, kSemxMagicResend);
+}
+
+bool UdpmSender::send_message(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t seqno,
+                              uint32_t fragment_magic) {
   sockaddr_in to{};
   to.sin_family = AF_INET;
   to.sin_addr.s_addr = group_;
@@ -115,7 +129,7 @@ bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::s
   const std::size_t first = room - name;
   const std::size_t count = 1 + (size - first + room - 1) / room;
   if (count > 0xffff) return false;
-  put32(header_.data(), kLcmMagicLong);
+  put32(header_.data(), fragment_magic);
   put32(header_.data() + 4, seqno);
   put32(header_.data() + 8, static_cast<uint32_t>(size));
   put16(header_.data() + 18, static_cast<uint16_t>(count));

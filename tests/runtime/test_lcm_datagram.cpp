@@ -57,8 +57,8 @@ struct Feed {
   LcmReassembler r{1 << 20};
   LcmMessageView m;
   bool complete = false;
-  DatagramError operator()(uint64_t sender, const std::vector<uint8_t>& d) {
-    return r.feed(sender, d.data(), d.size(), &m, &complete);
+  DatagramError operator()(uint64_t sender, const std::vector<uint8_t>& d, double now_s = 0) {
+    return r.feed(sender, d.data(), d.size(), &m, &complete, now_s);
   }
   std::vector<uint8_t> payload() const { return std::vector<uint8_t>(m.data, m.data + m.size); }
 };
@@ -98,21 +98,109 @@ TEST(LcmDatagram, FragmentsAreJoinedInAnyOrderAfterTheFirst) {
   EXPECT_EQ(f.r.counters().incomplete, 0);
 }
 
-TEST(LcmDatagram, FragmentsWithoutTheirFirstAreOrphansAndANewMessageAbandonsTheOld) {
+TEST(LcmDatagram, UntaggedFragmentsWithoutTheirFirstAreOrphansAndInterleavedMessagesBothComplete) {
   Feed f;
   const auto part = bytes(10, 1);
+  // liblcm's senders (untagged seqnos): a later fragment before its first is an orphan.
   EXPECT_EQ(f(5, fragment(7, 20, 10, 1, 2, "", part)), DatagramError::kNone);
   EXPECT_FALSE(f.complete);
   EXPECT_EQ(f.r.counters().orphans, 1);
+  // A sender's next message does not abandon the one before: on a bus with jitter they come
+  // interleaved.
   EXPECT_EQ(f(5, fragment(8, 20, 0, 0, 2, "A", part)), DatagramError::kNone);
-  EXPECT_EQ(f(5, fragment(9, 20, 0, 0, 2, "B", part)), DatagramError::kNone);  // 8 never finishes
-  EXPECT_EQ(f.r.counters().incomplete, 1);
-  EXPECT_EQ(f(5, fragment(8, 20, 10, 1, 2, "", part)), DatagramError::kNone);  // too late: an orphan
-  EXPECT_FALSE(f.complete);
-  EXPECT_EQ(f.r.counters().orphans, 2);
+  EXPECT_EQ(f(5, fragment(9, 20, 0, 0, 2, "B", part)), DatagramError::kNone);
+  EXPECT_EQ(f(5, fragment(8, 20, 10, 1, 2, "", part)), DatagramError::kNone);
+  ASSERT_TRUE(f.complete);
+  EXPECT_EQ(*f.m.channel, "A");
   EXPECT_EQ(f(5, fragment(9, 20, 10, 1, 2, "", part)), DatagramError::kNone);
   ASSERT_TRUE(f.complete);
   EXPECT_EQ(*f.m.channel, "B");
+  EXPECT_EQ(f.r.counters().incomplete, 0);
+}
+
+TEST(LcmDatagram, ATaggedMessageMayStartWithAnyFragment) {
+  // Tagged seqnos (semx's senders) passed the kernel filter for a wanted channel: the first
+  // fragment may come last.
+  Feed f;
+  const auto p = bytes(30, 5);
+  const uint32_t seq = kSeqnoTagged | (77u << kSeqnoTagShift) | 3;
+  EXPECT_EQ(f(5, fragment(seq, 30, 20, 2, 3, "", {p.begin() + 20, p.end()})), DatagramError::kNone);
+  EXPECT_EQ(f(5, fragment(seq, 30, 10, 1, 3, "", {p.begin() + 10, p.begin() + 20})), DatagramError::kNone);
+  EXPECT_FALSE(f.complete);
+  EXPECT_EQ(f(5, fragment(seq, 30, 0, 0, 3, "DEPTH", {p.begin(), p.begin() + 10})), DatagramError::kNone);
+  ASSERT_TRUE(f.complete);
+  EXPECT_EQ(*f.m.channel, "DEPTH");
+  EXPECT_EQ(f.payload(), p);
+  EXPECT_EQ(f.r.counters().orphans, 0);
+}
+
+namespace {
+std::vector<uint8_t> resent(std::vector<uint8_t> d) {
+  d[0] = 'S', d[1] = 'X', d[2] = 'R', d[3] = '3';
+  return d;
+}
+}  // namespace
+
+TEST(LcmDatagram, AResendFillsTheHolesOfTheFirstCopy) {
+  // Fragment 1 of the first copy and fragment 0 of the resend are lost: together they make the
+  // message. The rest of the resend, after the message was whole, starts nothing.
+  Feed f;
+  const auto p = bytes(3000, 11);
+  const uint32_t seq = kSeqnoTagged | (5u << kSeqnoTagShift) | 200;
+  std::vector<std::vector<uint8_t>> frags;
+  for (uint16_t k = 0; k < 3; ++k)
+    frags.push_back(fragment(seq, 3000, k * 1000u, k, 3, "ESDF_LOCAL", {p.begin() + k * 1000, p.begin() + (k + 1) * 1000}));
+  EXPECT_EQ(f(9, frags[0], 1.0), DatagramError::kNone);
+  EXPECT_EQ(f(9, frags[2], 1.0), DatagramError::kNone);
+  EXPECT_FALSE(f.complete);
+  EXPECT_EQ(f(9, resent(frags[2]), 1.05), DatagramError::kNone);  // held already: spare
+  EXPECT_FALSE(f.complete);
+  EXPECT_EQ(f(9, resent(frags[1]), 1.05), DatagramError::kNone);
+  ASSERT_TRUE(f.complete);
+  EXPECT_EQ(*f.m.channel, "ESDF_LOCAL");
+  EXPECT_EQ(f.payload(), p);
+  EXPECT_EQ(f.r.counters().filled, 1);
+  EXPECT_EQ(f(9, resent(frags[0]), 1.06), DatagramError::kNone);  // a second resend's rest
+  EXPECT_FALSE(f.complete);
+  EXPECT_EQ(f.r.counters().spare, 2);
+  EXPECT_EQ(f.r.pending_bytes(), 0u);
+  EXPECT_EQ(f.r.counters().rejected, 0);
+  // A resend of a message whose first copy never came makes it on its own.
+  const uint32_t seq2 = seq + 1;
+  for (uint16_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(f(9, resent(fragment(seq2, 3000, k * 1000u, k, 3, "ESDF_LOCAL",
+                                   {p.begin() + k * 1000, p.begin() + (k + 1) * 1000})), 1.1),
+              DatagramError::kNone);
+  }
+  ASSERT_TRUE(f.complete);
+  EXPECT_EQ(f.payload(), p);
+  // A first copy's fragment twice is malformed, as before (a resend's is not).
+  EXPECT_EQ(f(9, frags[0], 2.0), DatagramError::kNone);
+  EXPECT_EQ(f(9, frags[0], 2.0), DatagramError::kFragment);
+}
+
+TEST(LcmDatagram, AStaleIncompleteMessageIsAbandonedWhenItsSeqnoComesRound) {
+  // The sender's 8-bit counter came round: a second's old hole is not filled by a new message.
+  Feed f;
+  const auto a = bytes(20, 1), b = bytes(20, 2);
+  const uint32_t seq = kSeqnoTagged | (9u << kSeqnoTagShift) | 1;
+  EXPECT_EQ(f(4, fragment(seq, 20, 0, 0, 2, "X", {a.begin(), a.begin() + 10}), 10.0), DatagramError::kNone);
+  EXPECT_EQ(f(4, fragment(seq, 20, 10, 1, 2, "", {b.begin() + 10, b.end()}), 12.0), DatagramError::kNone);
+  EXPECT_FALSE(f.complete);
+  EXPECT_EQ(f.r.counters().incomplete, 1);
+  EXPECT_EQ(f(4, fragment(seq, 20, 0, 0, 2, "X", {b.begin(), b.begin() + 10}), 12.0), DatagramError::kNone);
+  ASSERT_TRUE(f.complete);
+  EXPECT_EQ(f.payload(), b);
+}
+
+TEST(LcmDatagram, EachSenderHoldsABoundedNumberOfIncompleteMessages) {
+  Feed f;
+  const auto part = bytes(10, 1);
+  for (uint32_t k = 0; k < 40; ++k)
+    EXPECT_EQ(f(5, fragment(kSeqnoTagged | k, 20, 0, 0, 2, "A", part)), DatagramError::kNone);
+  EXPECT_EQ(f.r.counters().incomplete, 40 - static_cast<int64_t>(LcmReassembler::kMaxPendingPerSender));
+  EXPECT_EQ(f(5, fragment(kSeqnoTagged | 39, 20, 10, 1, 2, "", part)), DatagramError::kNone);
+  EXPECT_TRUE(f.complete);  // the newest still completes
 }
 
 TEST(LcmDatagram, MalformedDatagramsAreRefusedAndCounted) {
@@ -167,7 +255,7 @@ TEST(LcmDatagram, ManySendersHoldBoundedMemory) {
   const auto part = bytes(100, 1);
   for (uint64_t s = 0; s < 1000; ++s)
     EXPECT_EQ(f(s, fragment(1, 1000, 0, 0, 10, "A", part)), DatagramError::kNone);
-  EXPECT_EQ(f.r.counters().incomplete, 1000 - 32);
+  EXPECT_EQ(f.r.counters().incomplete, 1000 - static_cast<int64_t>(LcmReassembler::kMaxPending));
   EXPECT_EQ(f(5000, small("B", part)), DatagramError::kNone);
   EXPECT_TRUE(f.complete);
 }
@@ -189,10 +277,10 @@ TEST(LcmDatagram, ClaimedSizesCannotHoldMoreThanTheBudget) {
   const auto p = bytes(1500, 4);
   const std::vector<uint8_t> a(p.begin(), p.begin() + 1000), b(p.begin() + 1000, p.end());
   auto d = fragment(2, 1500, 0, 0, 2, "REAL", a);
-  ASSERT_EQ(r.feed(19, d.data(), d.size(), &m, &complete), DatagramError::kNone);  // 19 moves on
+  ASSERT_EQ(r.feed(19, d.data(), d.size(), &m, &complete), DatagramError::kNone);  // abandons 18's
   d = fragment(2, 1500, 1000, 1, 2, "", b);
   ASSERT_EQ(r.feed(19, d.data(), d.size(), &m, &complete), DatagramError::kNone);
   ASSERT_TRUE(complete);
   EXPECT_EQ(std::vector<uint8_t>(m.data, m.data + m.size), p);
-  EXPECT_EQ(r.pending_bytes(), std::size_t{32} << 20);  // sender 18's claim is all that is left
+  EXPECT_EQ(r.pending_bytes(), std::size_t{32} << 20);  // sender 19's own claim is all that is left
 }

@@ -72,6 +72,10 @@ class Inbox {
   // A tick's heads: what must be held before the tick is handled. Returns true when nothing is
   // missing.
   bool tick(const std::vector<StreamHead>& heads, double now);
+  // An incomplete message's own trailer said it is `seq` of the stream (LcmReassembler's tails):
+  // unauthenticated, so it only makes the reader ask for the message at once, never makes it
+  // wait for one or count one lost; a seq far ahead of the stream is ignored.
+  void hint(const StreamKey& s, uint32_t seq);
   // True when no stream misses anything a tick or a later message said exists.
   bool complete() const;
   // The gaps to ask for now (each again every retry_s).
@@ -88,6 +92,12 @@ class Inbox {
   };
   // Held messages whose turn came, in order.
   bool ready(Ready* out);
+
+  // What a message sent again with its first counter (which the replay window refuses once it
+  // saw it, or once it is old) is to this reader: one it still waits for, one it holds or handed
+  // over already (counted as a duplicate), or one of a stream it does not know.
+  enum class Resent { kAwaited, kDuplicate, kUnknown };
+  Resent resent(const StreamKey& s, uint32_t seq);
 
   const InboxCounters& counters() const { return counters_; }
   void set_give_up_s(double s) { o_.give_up_s = s; }
@@ -106,8 +116,11 @@ class Inbox {
     double gap_since = -1;
     double last_request = -1;  // the last time missing messages were asked for again
     uint32_t asked = 0;        // everything up to here was asked for at least once
+    uint32_t hinted = 0;       // the last seq an incomplete message's trailer named
   };
   bool missing(const Stream& st) const { return st.next != 0 && st.next <= st.want; }
+  bool asking(const Stream& st) const { return missing(st) || (st.next != 0 && st.next <= st.hinted); }
+  static constexpr uint32_t kMaxHintAhead = 64;
   void release(const StreamKey& key, Stream& st);
   void start(Stream& st, uint32_t seq_seen, bool known_from_tick);
 
@@ -127,17 +140,21 @@ class ResendHistory {
  public:
   explicit ResendHistory(std::size_t per_channel = 64, std::size_t bytes_per_channel = 16u << 20)
       : per_channel_(per_channel), bytes_per_channel_(bytes_per_channel) {}
-  // Keeps `bytes` (the payload, without its trailer) as message `seq` of `channel`, taking its
-  // buffer; gives back an old buffer to reuse.
-  std::vector<uint8_t> keep(const std::string& channel, uint32_t tag, uint32_t seq, std::vector<uint8_t>&& bytes);
-  // The payload of message `seq` on the channel with `tag`, if still kept.
-  const std::vector<uint8_t>* find(uint32_t tag, uint32_t seq, const std::string** channel) const;
+  // Keeps `bytes` (the signed message as sent) as message `seq` of `channel`, taking its buffer;
+  // gives back an old buffer to reuse. `wire_seqno`: the transport's seqno it went with (0:
+  // none), under which a resend lets readers join its fragments with those they hold.
+  std::vector<uint8_t> keep(const std::string& channel, uint32_t tag, uint32_t seq, std::vector<uint8_t>&& bytes,
+                            uint32_t wire_seqno = 0);
+  // Message `seq` on the channel with `tag`, if still kept.
+  const std::vector<uint8_t>* find(uint32_t tag, uint32_t seq, const std::string** channel,
+                                   uint32_t* wire_seqno = nullptr) const;
   std::size_t bytes() const { return total_bytes_; }
 
  private:
   struct Kept {
     uint32_t seq;
     std::vector<uint8_t> bytes;
+    uint32_t wire_seqno = 0;
   };
   struct Channel {
     std::string name;

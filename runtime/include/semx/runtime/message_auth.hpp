@@ -123,8 +123,14 @@ class MessageVerifier {
 
   AuthVerdict verify(const std::string& channel, const uint8_t* data, std::size_t size,
                      AuthTrailer* trailer = nullptr);
+  // The tag alone, without the replay window: for a message verify() called replayed that the
+  // reader still waits for (a publisher's resend carries the bytes it first sent, counter and
+  // all, so readers can join its fragments with those of the first copy; delivery.hpp).
+  bool authentic(const std::string& channel, const uint8_t* data, std::size_t size);
   uint64_t session() const { return session_; }
   std::size_t senders() const { return senders_.size(); }
+  // A sender one of whose messages was verified.
+  bool knows(uint64_t sender) const { return senders_.count(sender) > 0; }
 
  private:
   struct Cipher;

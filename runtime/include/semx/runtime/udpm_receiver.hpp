@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <queue>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,8 @@ std::optional<UdpmEndpoint> parse_udpm_url(const std::string& url);
 // datagrams of `channels` (exact names) and drops the rest, or, with `refuse`, drops those of
 // `channels` and passes the rest. Fragments after the first name no channel: one whose sequence
 // number carries a channel tag (udpm_sender.hpp) is judged by the tag, an untagged one (liblcm's
-// senders) always passes; the reassembler drops those whose first fragment was refused.
+// senders) always passes; the reassembler drops those whose first fragment was refused. Fragments
+// sent again (SXR3, lcm_datagram.hpp) are all judged by their tag.
 std::vector<sock_filter> lcm_channel_filter(const std::vector<std::string>& channels, bool refuse = false);
 
 class UdpmReceiver {
@@ -62,10 +64,13 @@ class UdpmReceiver {
   // completes. The view is valid until the next call. A bad datagram is counted and skipped, and
   // its reason left in last_error().
   bool next(LcmMessageView* out);
-  // Waits up to timeout_ms for a datagram; false on timeout or a signal.
+  // Waits up to timeout_ms for a datagram (or a delayed one's turn); false on timeout or a signal.
   bool wait(int timeout_ms) const;
 
   int fd() const { return fd_; }
+  // Incomplete messages' last bytes (LcmReassembler::report_tails).
+  void report_tails(std::size_t bytes) { reassembler_.report_tails(bytes); }
+  bool next_tail(LcmReassembler::Tail* out) { return reassembler_.next_tail(out); }
   const ReassemblyCounters& counters() const { return reassembler_.counters(); }
   DatagramError last_error() const { return last_error_; }
   int64_t socket_errors() const { return socket_errors_; }
@@ -79,6 +84,14 @@ class UdpmReceiver {
     drop_state_ = seed * 0x9E3779B97F4A7C15ull + 1;
   }
   int64_t dropped_for_test() const { return dropped_for_test_; }
+  // For tests of a bus with jitter: each datagram is handed to reassembly `uniform(0, max_s)`
+  // seconds after it came (seeded), independently of the others, so datagrams and the fragments
+  // of one message come out of order, as on a loaded network. Node sets it from
+  // SEMX_TEST_JITTER_MS.
+  void delay_for_test(double max_s, uint64_t seed) {
+    delay_max_s_ = max_s;
+    delay_state_ = seed * 0xBF58476D1CE4E5B9ull + 1;
+  }
   int granted_recv_buf() const { return granted_recv_buf_; }
 
  private:
@@ -93,6 +106,21 @@ class UdpmReceiver {
   int64_t dropped_for_test_ = 0;
   int granted_recv_buf_ = 0;
   std::string name_;
+  struct Delayed {
+    double due = 0;
+    uint64_t order = 0;
+    uint64_t sender = 0;
+    std::vector<uint8_t> bytes;
+    bool operator>(const Delayed& o) const { return due > o.due || (due == o.due && order > o.order); }
+  };
+  bool read_datagram(std::size_t* n, uint64_t* sender);  // false when none is queued
+  bool drop_now();
+  bool next_delayed(LcmMessageView* out);
+  double delay_max_s_ = 0;
+  uint64_t delay_state_ = 1;
+  uint64_t delay_order_ = 0;
+  std::priority_queue<Delayed, std::vector<Delayed>, std::greater<Delayed>> delayed_;
+  std::vector<uint8_t> current_;  // the delayed datagram a view may point into
 };
 
 }  // namespace semx::runtime

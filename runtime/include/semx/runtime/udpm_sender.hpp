@@ -17,14 +17,8 @@
 
 namespace semx::runtime {
 
-// seqno = kSeqnoTagged | tag << 8 | counter: liblcm's senders count from 0 and reach the marker
-// only after 2^32 - 2^28 messages, so their fragments stay untagged and always pass the filter.
-// A receiver only compares a sender's seqnos for equality, and one sender's consecutive messages
-// differ in the counter or the tag.
-inline constexpr uint32_t kSeqnoTagMask = 0xF0000000u;
-inline constexpr uint32_t kSeqnoTagged = 0xF0000000u;
-inline constexpr int kSeqnoTagShift = 8;
-inline constexpr uint32_t kSeqnoTagBits = 0xFFFFFu;
+// The seqno's layout is in lcm_datagram.hpp (kSeqnoTagged): liblcm's senders' fragments stay
+// untagged and always pass the filter.
 // A 20-bit hash of the name, never 0. Two channels with one tag would let each other's later
 // fragments through a filter that wants one of them, or drop them in one that refuses one of
 // them (semx's own channels have distinct tags, a test checks).
@@ -43,13 +37,21 @@ class UdpmSender {
   UdpmSender& operator=(const UdpmSender&) = delete;
 
   // Sends one message as one datagram or as fragments; false when the name is not a channel
-  // liblcm could carry or the kernel refused a datagram.
-  bool publish(const std::string& channel, const uint8_t* data, std::size_t size);
+  // liblcm could carry or the kernel refused a datagram. `*seqno`, when given, is the seqno it
+  // went with (what publish_again() needs).
+  bool publish(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t* seqno = nullptr);
+  // Sends a message published before again, byte for byte: a fragmented one as SXR3 fragments
+  // under its first seqno (lcm_datagram.hpp), so readers join them with the fragments they hold;
+  // a one-datagram one as a new message.
+  bool publish_again(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t seqno);
 
   // The largest datagram this sender writes (liblcm reads up to 64 KiB).
   static constexpr std::size_t kMaxDatagram = 65000;
 
  private:
+  bool send_message(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t seqno,
+                    uint32_t fragment_magic);
+
   int fd_ = -1;
   BusPacer pacer_;
   std::unique_ptr<BusListeners> listeners_;
