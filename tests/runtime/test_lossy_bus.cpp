@@ -260,6 +260,7 @@ TEST(LossyBus, LargeMessagesAreMadeWholeFromTheFragmentsOfSeveralCopiesDespiteLo
   EXPECT_EQ(frames, want_frames);
   EXPECT_EQ(sub.counters().lost, 0);
   EXPECT_GT(sub.counters().recovered, 5) << "no loss: the drop filter did not work";
-  // Odometry lost and asked for again is resent too: at most a few resends per frame on top.
-  EXPECT_LT(pub.counters().resent, 60 + 4 * 20) << "resends do not fill holes";
+  // Whole copies would take ~70 resends a frame (1400 here); filling holes takes a few, plus
+  // the lost odometry (~40) and retries that cross an answer on its way (more under load).
+  EXPECT_LT(pub.counters().resent, 400) << "resends do not fill holes";
 }
