@@ -47,6 +47,13 @@ MapMirror::DeltaResult MapMirror::apply(const MapDelta& d) {
     apply_changes(d);
     return DeltaResult::kApplied;
   }
+  if (!needs_snapshot_ && d.seq <= seq_) {
+    // Snapshots and updates are two channels, each in its publisher's order but not against each
+    // other: on a lossy or jittery bus the snapshot of map s can come before update s, which it
+    // holds. Not a gap.
+    ++counters_.deltas_ignored;
+    return DeltaResult::kIgnored;
+  }
   if (!needs_snapshot_) {
     needs_snapshot_ = true;
     ++counters_.gaps;

@@ -69,7 +69,7 @@ bool tracked(const std::string& channel) {
 
 // In lockstep a gap costs only wall time, so it is waited for long (and a recorder wants every
 // message); in realtime a message that comes much later is old news.
-constexpr double kGiveUpLockstepS = 10.0, kGiveUpRealtimeS = 0.3;
+constexpr double kGiveUpLockstepS = 10.0, kGiveUpRealtimeS = 0.5;
 // With no SIM_CLOCK for this long (the clock resends its tick every 50 ms while it waits), the
 // clock is gone: messages waiting for a tick are handed over (a mapper's last request).
 constexpr double kClockGoneS = 3.0;

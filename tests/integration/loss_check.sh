@@ -5,15 +5,20 @@
 #
 #   tests/integration/loss_check.sh [--world env1] [--seed 1] [--time-limit 60] [--drop 0.1]
 #                                   [--drop-seed 3] [--planner semantic-dep] [--out DIR] [--build DIR]
+#                                   [--clock lockstep|realtime] [--jitter MS] [--tolerance PTS]
 #
-# Exit 0 when coverage, object coverage, Time_f, Time_r, Time_o, distance, collisions and the
-# termination are equal and the lossy run is valid (no message lost for good); 1 otherwise. Also
+# Lockstep: exit 0 when coverage, object coverage, Time_f, Time_r, Time_o, distance, collisions and
+# the termination are equal and the lossy run is valid (no message lost for good); 1 otherwise.
+# Realtime (`--clock realtime`, where no two runs are equal): exit 0 when the lossy run's coverage
+# is within --tolerance points (2) of the clean run's and it is valid. `--jitter MS` also delays
+# each datagram by up to MS milliseconds, out of order (SEMX_TEST_JITTER_MS). Also
 # checks that each process of the lossy run asked for messages again (SIM_RESEND in run.lcmlog):
 # the drop reached it. Runs in a private network namespace when it can (as root), so no other
 # set hears it; otherwise the launcher's bus claim gives the set a port of its own.
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
 world=env1 seed=1 time_limit=60 drop=0.1 drop_seed=3 planner=semantic-dep out="" build="$ROOT/build"
+clock=lockstep jitter=0 tolerance=2
 while [ $# -gt 0 ]; do
   case "$1" in
     --world) world=$2; shift 2 ;;
@@ -24,6 +29,9 @@ while [ $# -gt 0 ]; do
     --planner) planner=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
+    --clock) clock=$2; shift 2 ;;
+    --jitter) jitter=$2; shift 2 ;;
+    --tolerance) tolerance=$2; shift 2 ;;
     --in-netns) in_netns=1; shift ;;
     *) echo "loss_check: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -33,8 +41,9 @@ mkdir -p "$out"
 if [ -z "${in_netns:-}" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
   exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@" --in-netns' \
     "$0" --world "$world" --seed "$seed" --time-limit "$time_limit" --drop "$drop" --drop-seed "$drop_seed" \
-    --planner "$planner" --out "$out" --build "$build"
+    --planner "$planner" --out "$out" --build "$build" --clock "$clock" --jitter "$jitter" --tolerance "$tolerance"
 fi
+case "$clock" in lockstep|realtime) ;; *) echo "loss_check: --clock '$clock': expected lockstep or realtime" >&2; exit 2 ;; esac
 launch="$build/bin/semx-launch"
 [ -x "$launch" ] || { echo "loss_check: no $launch (build first)" >&2; exit 2; }
 
@@ -47,23 +56,29 @@ run() {  # run NAME [ENV=VALUE ...]
   shift
   rm -rf "$dir"
   env "$@" "$launch" demo --no-color --arg "world=$world" --arg "seed=$seed" --arg "planner=$planner" \
-    --arg "time_limit=$time_limit" --arg "out=$dir" >"$dir.console" 2>&1
+    --arg "time_limit=$time_limit" --arg "clock=$clock" --arg "out=$dir" >"$dir.console" 2>&1
   echo $? >"$dir.rc"
 }
 
 run clean
-run lossy SEMX_TEST_DROP_RATE="$drop" SEMX_TEST_DROP_SEED="$drop_seed"
+run lossy SEMX_TEST_DROP_RATE="$drop" SEMX_TEST_DROP_SEED="$drop_seed" SEMX_TEST_JITTER_MS="$jitter"
 
 failed=0
 keys="coverage_pct object_coverage_pct time_f_s time_r_s time_o_s distance_m collisions termination"
-printf '%-20s %16s %16s %s\n' figure clean "lossy ($drop)" check
+printf '%-20s %16s %16s %s\n' figure clean "lossy ($drop, ${jitter} ms)" check
 for k in $keys valid wall_s; do
   a=$(json "$out/clean/metrics.json" "$k" 2>/dev/null) b=$(json "$out/lossy/metrics.json" "$k" 2>/dev/null)
   check=ok
   case "$k" in
     wall_s) check="-" ;;
     valid) [ "$b" = true ] || { check="lossy run not valid"; failed=1; } ;;
-    *) [ -n "$a" ] && [ "$a" = "$b" ] || { check=DIFFERENT; failed=1; } ;;
+    coverage_pct) if [ "$clock" = realtime ]; then
+        awk -v a="${a:-0}" -v b="${b:-0}" -v t="$tolerance" 'BEGIN { exit !(a != "" && b != "" && a - b <= t && b - a <= t) }' ||
+          { check="more than $tolerance points apart"; failed=1; }
+      else
+        [ -n "$a" ] && [ "$a" = "$b" ] || { check=DIFFERENT; failed=1; }
+      fi ;;
+    *) if [ "$clock" = realtime ]; then check="-"; else [ -n "$a" ] && [ "$a" = "$b" ] || { check=DIFFERENT; failed=1; }; fi ;;
   esac
   printf '%-20s %16s %16s %s\n' "$k" "${a:--}" "${b:--}" "$check"
 done

@@ -167,6 +167,14 @@ TEST(Streaming, MirrorRefusesDeltasAfterAGapUntilASnapshot) {
   EXPECT_EQ(mirror.state(map::VoxelKey{3, 0, 0}), map::VoxelState::kFree);
   // An old snapshot is ignored while in sequence.
   EXPECT_EQ(mirror.apply(map::encode_snapshot(at2, 2)), map::MapMirror::SnapshotResult::kIgnored);
+  // So is an update the mirror holds already (the snapshot of a later map came first, on
+  // another channel): not a gap, nothing changes.
+  const int64_t gaps = mirror.counters().gaps;
+  map::MapDelta old2{2, 0, 0.1, {{{1, 0, 0}, map::VoxelState::kOccupied}}};
+  EXPECT_EQ(mirror.apply(old2), map::MapMirror::DeltaResult::kIgnored);
+  EXPECT_FALSE(mirror.needs_snapshot());
+  EXPECT_EQ(mirror.counters().gaps, gaps);
+  EXPECT_EQ(mirror.state(map::VoxelKey{1, 0, 0}), map::VoxelState::kFree);
   // Wrong resolution and out-of-range keys are rejected without touching the mirror.
   map::MapDelta bad_res{5, 0, 0.2, {}};
   EXPECT_EQ(mirror.apply(bad_res), map::MapMirror::DeltaResult::kRejected);

@@ -24,6 +24,7 @@ class MapMirror {
     kApplied,   // the mirror is now at delta.seq
     kBuffered,  // out of sequence: kept for after the next snapshot; needs_snapshot() is true
     kRejected,  // wrong resolution or malformed (key out of range): dropped
+    kIgnored,   // a map the mirror holds already (a snapshot of a later map came first)
   };
   enum class SnapshotResult {
     kApplied,
@@ -51,6 +52,7 @@ class MapMirror {
     int64_t deltas_applied = 0;
     int64_t deltas_buffered = 0;
     int64_t deltas_rejected = 0;
+    int64_t deltas_ignored = 0;
     int64_t gaps = 0;  // times the mirror found itself out of sequence
     int64_t snapshots_applied = 0;
     int64_t snapshots_ignored = 0;
