@@ -35,6 +35,7 @@ void MapMirror::apply_changes(const MapDelta& d) {
     grid_.set_state(c.key, c.state);
   }
   seq_ = d.seq;
+  last_delta_seq_ = d.seq;
   ++counters_.deltas_applied;
 }
 
@@ -47,10 +48,11 @@ MapMirror::DeltaResult MapMirror::apply(const MapDelta& d) {
     apply_changes(d);
     return DeltaResult::kApplied;
   }
-  if (!needs_snapshot_ && d.seq <= seq_) {
+  if (!needs_snapshot_ && d.seq > last_delta_seq_ && d.seq <= seq_) {
     // Snapshots and updates are two channels, each in its publisher's order but not against each
-    // other: on a lossy or jittery bus the snapshot of map s can come before update s, which it
-    // holds. Not a gap.
+    // other: on a lossy or jittery bus the snapshot of map s can come before the updates after the
+    // last one applied, up to s, which it holds. Not a gap. (An update at or below the last one
+    // applied is a mapper that began again: a gap.)
     ++counters_.deltas_ignored;
     return DeltaResult::kIgnored;
   }

@@ -82,6 +82,7 @@ class MapMirror {
   StateGrid grid_;
   MapDelta last_applied_;
   int64_t seq_ = 0;
+  int64_t last_delta_seq_ = 0;  // seq_ may be a snapshot's, ahead of the updates applied
   bool needs_snapshot_ = false;
   size_t max_buffered_;
   std::map<int64_t, MapDelta> buffer_;
