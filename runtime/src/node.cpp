@@ -675,7 +675,9 @@ void Node::on_clock_message(const semx::clock_t& msg) {
   const bool complete = inbox_.tick(heads, wall_s());
   HeldTick held{msg, {}};
   for (const StreamHead& h : heads) held.heads[h.stream] = std::max(held.heads[h.stream], h.seq);
-  if (!complete || !held_ticks_.empty()) {
+  // In realtime a tick is not held for what it names: what is missing is asked for and handed
+  // over when it comes, while time goes on (a controller held for a lost ESDF would not steer).
+  if (msg.mode != semx::clock_t::REALTIME && (!complete || !held_ticks_.empty())) {
     held_ticks_.push_back(std::move(held));
     service_delivery();
     return;
@@ -720,12 +722,16 @@ void Node::handle_tick(const semx::clock_t& msg, bool may_ack) {
   const bool skip_ack = decision.new_tick && !decision.reset && quiet_until_ > msg.utime &&
                         last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
                         msg.utime - last_ack_utime_ < kAckIntervalUs;
-  if (decision.ack && may_ack && !skip_ack) {
+  const bool heads_ack = !decision.ack && may_ack && msg.mode == semx::clock_t::REALTIME && !options_.observer &&
+                         options_.sign && wall_s() - last_heads_ack_wall_ >= kRealtimeHeadsPeriodS &&
+                         !own_heads().empty();
+  if ((decision.ack && may_ack && !skip_ack) || heads_ack) {
+    if (heads_ack) last_heads_ack_wall_ = wall_s();
     semx::ack_t ack{};
     ack.utime = msg.utime;
     ack.node = options_.name;
     ack.tick = msg.tick;
-    ack.quiet_until = quiet_until_fn_ ? quiet_until_fn_(msg.utime) : 0;
+    ack.quiet_until = !heads_ack && quiet_until_fn_ ? quiet_until_fn_(msg.utime) : 0;
     ack.sender = static_cast<int64_t>(signer_.sender());
     for (const auto& [tag, seq] : own_heads()) {
       ack.head_tag.push_back(tag);
@@ -733,8 +739,10 @@ void Node::handle_tick(const semx::clock_t& msg, bool may_ack) {
     }
     ack.num_heads = static_cast<int16_t>(ack.head_seq.size());
     publish(channels::SIM_ACK, ack);
-    quiet_until_ = ack.quiet_until;
-    last_ack_utime_ = msg.utime;
+    if (!heads_ack) {
+      quiet_until_ = ack.quiet_until;
+      last_ack_utime_ = msg.utime;
+    }
   }
   std::vector<std::function<void()>> work;
   work.swap(after_ack_);

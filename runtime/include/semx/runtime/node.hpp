@@ -333,6 +333,11 @@ class Node {
   std::function<int64_t(int64_t)> quiet_until_fn_;
   std::vector<std::function<void()>> after_ack_;
   int64_t last_ack_utime_ = -1;
+  // In realtime nothing acks a tick, so a reader that lost a stream's last message (a plan, a
+  // status) would not know until the next one came, if ever: every node tells the clock its
+  // heads in an ack this often (wall seconds), and the ticks pass them on.
+  static constexpr double kRealtimeHeadsPeriodS = 0.1;
+  double last_heads_ack_wall_ = -1;
   int64_t quiet_until_ = 0;  // the promise sent with the last ack
   int64_t tick_period_us_ = 0;
   bool in_tick_ = false;
