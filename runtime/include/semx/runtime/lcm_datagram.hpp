@@ -84,8 +84,10 @@ class LcmReassembler {
  public:
   explicit LcmReassembler(std::size_t max_message_bytes);
 
-  static constexpr std::size_t kMaxPending = 64;          // bounds hostile senders on many ports
-  static constexpr std::size_t kMaxPendingPerSender = 16;
+  static constexpr std::size_t kMaxPending = 128;  // bounds hostile senders on many ports
+  // A simulator sends ~60 frames a second, most of them incomplete at 10 % loss until a resend
+  // fills them, a resend taking up to 0.1 s with jitter.
+  static constexpr std::size_t kMaxPendingPerSender = 48;
   // How long a completed message's seqno stays known, so that the rest of a resend that came
   // after it completed starts nothing.
   static constexpr double kDoneMemoryS = 0.5;
