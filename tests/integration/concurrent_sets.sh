@@ -11,25 +11,21 @@
 # a private network namespace when it can (root), so no other set on the machine takes part.
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
-out="" time_limit=60 in_netns="" args=("$@")
+. "$ROOT/tests/integration/lib.sh"
+semx_private_netns "$0" "$@"
+out="" time_limit=60
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
     --time-limit) time_limit=$2; shift 2 ;;
-    --in-netns) in_netns=1; shift ;;
     -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
     *) echo "concurrent_sets: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 [ -n "$out" ] || out=$(mktemp -d /tmp/concurrent-sets.XXXXXX)
 mkdir -p "$out" && out=$(readlink -f "$out")
-if [ -z "$in_netns" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
-  exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@"' \
-    "$0" "${args[@]}" --out "$out" --in-netns
-fi
 unset LCM_DEFAULT_URL
 say() { echo "concurrent_sets: $*"; }
-json() { sed -n "s/^  \"$2\": \\(.*\\),\$/\\1/p" "$1" | tr -d '"'; }
 
 demo_a() { "$ROOT/semx" demo --world env1 --seed 1 --time-limit "$time_limit" --out "$1" >"$1.console" 2>&1; }
 demo_b() { "$ROOT/semx" demo --world env2 --seed 1 --time-limit "$time_limit" --out "$1" >"$1.console" 2>&1; }

@@ -20,8 +20,9 @@
 # (the threat model, docs/runtime.md). Runs in a private network namespace when it can (root).
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
-world=env1 seed=1 time_limit=60 min=100000 streams=4 rate=3000 batch=600 out="" build="$ROOT/build" in_netns=""
-args=("$@")
+. "$ROOT/tests/integration/lib.sh"
+semx_private_netns "$0" "$@"
+world=env1 seed=1 time_limit=60 min=100000 streams=4 rate=3000 batch=600 out="" build="$ROOT/build"
 while [ $# -gt 0 ]; do
   case "$1" in
     --world) world=$2; shift 2 ;;
@@ -33,24 +34,15 @@ while [ $# -gt 0 ]; do
     --batch) batch=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
-    --in-netns) in_netns=1; shift ;;
     -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) echo "hostile_campaign: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 [ -n "$out" ] || out=$(mktemp -d /tmp/hostile-campaign.XXXXXX)
 mkdir -p "$out" && out=$(readlink -f "$out")
-if [ -z "$in_netns" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
-  exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@"' \
-    "$0" "${args[@]}" --out "$out" --in-netns
-fi
 launch="$build/bin/semx-launch" hostile="$build/bin/semx-hostile"
 for b in "$launch" "$hostile"; do [ -x "$b" ] || { echo "hostile_campaign: no $b (build first)" >&2; exit 2; }; done
 say() { echo "hostile_campaign: $*"; }
-
-json() {  # json FILE KEY: a scalar of metrics.json
-  sed -n "s/^  \"$2\": \\(.*\\),\$/\\1/p" "$1" | tr -d '"'
-}
 
 # run NAME: a lockstep demo run in OUT/NAME (console in OUT/NAME.console); returns its exit code.
 run() {

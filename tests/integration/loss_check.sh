@@ -17,6 +17,8 @@
 # set hears it; otherwise the launcher's bus claim gives the set a port of its own.
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
+. "$ROOT/tests/integration/lib.sh"
+semx_private_netns "$0" "$@"
 world=env1 seed=1 time_limit=60 drop=0.1 drop_seed=3 planner=semantic-dep out="" build="$ROOT/build"
 clock=lockstep jitter=0 tolerance=2
 while [ $# -gt 0 ]; do
@@ -32,24 +34,14 @@ while [ $# -gt 0 ]; do
     --clock) clock=$2; shift 2 ;;
     --jitter) jitter=$2; shift 2 ;;
     --tolerance) tolerance=$2; shift 2 ;;
-    --in-netns) in_netns=1; shift ;;
     *) echo "loss_check: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 [ -n "$out" ] || out=$(mktemp -d /tmp/loss-check.XXXXXX)
 mkdir -p "$out"
-if [ -z "${in_netns:-}" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
-  exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@" --in-netns' \
-    "$0" --world "$world" --seed "$seed" --time-limit "$time_limit" --drop "$drop" --drop-seed "$drop_seed" \
-    --planner "$planner" --out "$out" --build "$build" --clock "$clock" --jitter "$jitter" --tolerance "$tolerance"
-fi
 case "$clock" in lockstep|realtime) ;; *) echo "loss_check: --clock '$clock': expected lockstep or realtime" >&2; exit 2 ;; esac
 launch="$build/bin/semx-launch"
 [ -x "$launch" ] || { echo "loss_check: no $launch (build first)" >&2; exit 2; }
-
-json() {  # json FILE KEY: a scalar of metrics.json
-  sed -n "s/^  \"$2\": \\(.*\\),\$/\\1/p" "$1" | tr -d '"'
-}
 
 run() {  # run NAME [ENV=VALUE ...]
   local name=$1 dir="$out/$1"

@@ -12,6 +12,8 @@
 # check. Runs in a private network namespace when it can (as root), so no other set hears it.
 set -uo pipefail
 ROOT=$(cd "$(dirname "$(readlink -f "$0")")/../.." && pwd)
+. "$ROOT/tests/integration/lib.sh"
+semx_private_netns "$0" "$@"
 world=env1 seed=1 rng=1 out="" build="$ROOT/build"
 procs="mapper planner controller semantics simulator evaluator logger"
 while [ $# -gt 0 ]; do
@@ -22,22 +24,13 @@ while [ $# -gt 0 ]; do
     --out) out=$2; shift 2 ;;
     --procs) procs=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
-    --in-netns) in_netns=1; shift ;;
     *) echo "respawn_check: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 [ -n "$out" ] || out=$(mktemp -d /tmp/respawn-check.XXXXXX)
 mkdir -p "$out"
-if [ -z "${in_netns:-}" ] && [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
-  exec unshare --net bash -c 'ip link set lo up; ip route add 224.0.0.0/4 dev lo; exec "$0" "$@" --in-netns' \
-    "$0" --world "$world" --seed "$seed" --rng "$rng" --out "$out" --procs "$procs" --build "$build"
-fi
 launch="$build/bin/semx-launch"
 [ -x "$launch" ] || { echo "respawn_check: no $launch (build first)" >&2; exit 2; }
-
-json() {  # json FILE KEY: a scalar of metrics.json
-  sed -n "s/^  \"$2\": \\(.*\\),\$/\\1/p" "$1" | tr -d '"'
-}
 
 # run NAME [PROC AT_S]: a demo run, PROC killed with SIGKILL once the evaluator reports
 # simulated time AT_S (its progress line every simulated second).
