@@ -208,6 +208,8 @@ const char* to_string(AuthVerdict v) {
       return "forged";
     case AuthVerdict::kReplayed:
       return "replayed";
+    case AuthVerdict::kCrowded:
+      return "surplus sender's";
   }
   return "?";
 }
@@ -265,6 +267,7 @@ AuthVerdict MessageVerifier::verify(const std::string& channel, const uint8_t* d
   if (trailer) *trailer = *a;
   if (a->session != session_) return AuthVerdict::kForeign;
   const auto it = senders_.find(a->sender);
+  if (it == senders_.end() && senders_.size() >= kMaxSenders) return AuthVerdict::kCrowded;
   Sender fresh;
   Sender& s = it != senders_.end() ? it->second : fresh;
   if (it == senders_.end()) fresh.key = key_.sender_key(a->sender);

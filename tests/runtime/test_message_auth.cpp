@@ -100,6 +100,56 @@ TEST(MessageAuth, ReplaysAreRefusedReorderingWithinTheWindowIsNot) {
   EXPECT_EQ(verifier.verify("ODOMETRY", sent[98].data(), sent[98].size()), AuthVerdict::kOk);
 }
 
+TEST(MessageAuth, AResendAwaitedIsAuthenticBeyondTheWindowAndAForgedOneIsNot) {
+  // A publisher resends the bytes it first sent, counter and all: past the window the verifier
+  // calls it replayed, and the node asks authentic() when its inbox still waits for it.
+  const AuthKey key = AuthKey::random();
+  MessageSigner signer(key);
+  MessageVerifier verifier(key);
+  std::vector<std::vector<uint8_t>> sent;
+  for (int i = 0; i < 100; ++i) {
+    auto b = payload(20, static_cast<uint8_t>(i));
+    signer.sign("ESDF_LOCAL", b);
+    sent.push_back(b);
+  }
+  EXPECT_EQ(verifier.verify("ESDF_LOCAL", sent[99].data(), sent[99].size()), AuthVerdict::kOk);
+  EXPECT_EQ(verifier.verify("ESDF_LOCAL", sent[3].data(), sent[3].size()), AuthVerdict::kReplayed);
+  EXPECT_TRUE(verifier.authentic("ESDF_LOCAL", sent[3].data(), sent[3].size()));
+  EXPECT_FALSE(verifier.authentic("PLAN_PATH", sent[3].data(), sent[3].size())) << "another channel's";
+  auto tampered = sent[3];
+  tampered[2] ^= 1;
+  EXPECT_FALSE(verifier.authentic("ESDF_LOCAL", tampered.data(), tampered.size()));
+  const AuthKey other = AuthKey::random();
+  MessageSigner stranger(other);
+  auto foreign = payload(20);
+  stranger.sign("ESDF_LOCAL", foreign);
+  EXPECT_FALSE(verifier.authentic("ESDF_LOCAL", foreign.data(), foreign.size()));
+}
+
+TEST(MessageAuth, NewSendersBeyondTheLimitAreRefusedKnownOnesAreNot) {
+  const AuthKey key = AuthKey::random();
+  MessageVerifier verifier(key);
+  MessageSigner first(key);
+  auto b = payload(8);
+  first.sign("ODOMETRY", b);
+  ASSERT_EQ(verifier.verify("ODOMETRY", b.data(), b.size()), AuthVerdict::kOk);
+  for (std::size_t i = 1; i < MessageVerifier::kMaxSenders; ++i) {
+    MessageSigner s(key);
+    auto m = payload(8);
+    s.sign("ODOMETRY", m);
+    ASSERT_EQ(verifier.verify("ODOMETRY", m.data(), m.size()), AuthVerdict::kOk) << i;
+  }
+  EXPECT_EQ(verifier.senders(), MessageVerifier::kMaxSenders);
+  MessageSigner late(key);
+  auto m = payload(8);
+  late.sign("ODOMETRY", m);
+  EXPECT_EQ(verifier.verify("ODOMETRY", m.data(), m.size()), AuthVerdict::kCrowded);
+  EXPECT_EQ(verifier.senders(), MessageVerifier::kMaxSenders);
+  auto again = payload(8);
+  first.sign("ODOMETRY", again);
+  EXPECT_EQ(verifier.verify("ODOMETRY", again.data(), again.size()), AuthVerdict::kOk);
+}
+
 TEST(MessageAuth, KeysFromHexFilesAndTheEnvironment) {
   const AuthKey key = AuthKey::random();
   const std::string dir = testing::TempDir() + "/semx_auth_" + std::to_string(::getpid());

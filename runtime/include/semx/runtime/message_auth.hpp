@@ -106,6 +106,7 @@ enum class AuthVerdict {
   kForeign,   // another session's (another set on the same bus)
   kForged,    // the tag does not match: not made with this set's key, or altered
   kReplayed,  // a counter this sender used already, or older than the window
+  kCrowded,   // a new sender when kMaxSenders are known already (a flood of insider senders)
 };
 const char* to_string(AuthVerdict v);
 
@@ -120,6 +121,9 @@ class MessageVerifier {
   MessageVerifier& operator=(const MessageVerifier&) = delete;
 
   static constexpr uint64_t kWindow = 64;
+  // A set has a few dozen senders, respawns included: beyond this many, a new one is refused, so
+  // a flood of senders with the key cannot grow this map (and each reader's inbox) without bound.
+  static constexpr std::size_t kMaxSenders = 4096;
 
   AuthVerdict verify(const std::string& channel, const uint8_t* data, std::size_t size,
                      AuthTrailer* trailer = nullptr);
