@@ -361,6 +361,9 @@ struct OracleConfig {
   // with e = 0.5 walked alone, DEP 119 s (docs/planner.md, "The known-map oracle").
   double first_pass = 0.9;
   double target_share = 0.95;  // of T: the evaluator's Time_95
+  // ... and the share of the evaluator's Time_r: the schedule is chosen (and reordered) for the
+  // sum of the model's times to the two shares, so that it bounds both.
+  double early_share = 0.85;
   // Objectives the first pass's reordering (Or-opt, 2-opt, drops judged by the model's time to
   // target_share of T) may ask for; 0: the schedule as chosen.
   int improve_evaluations = 3000;
