@@ -427,7 +427,10 @@ std::string OracleSummary::describe() const {
   s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
     << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
     << first_pass << " in the first pass, e " << first_pass_exponent << (first_pass_toured ? " toured" : " walked")
-    << ", modelled " << first_pass_target_time << " s to the target share) see " << 100.0 * cover_share() << " % of that (" << cover_dropped
+    << (first_pass_improved ? ", reordered" : "") << ", modelled " << first_pass_early_time << " / "
+    << first_pass_target_time << " s to the early / target share";
+  if (first_pass_improved) s << " (sum " << first_pass_before_improvement << " s before reordering)";
+  s << ") see " << 100.0 * cover_share() << " % of that (" << cover_dropped
     << " redundant dropped); tour "
     << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
     << "; prepared in " << prepare_ms / 1000.0 << " s";
@@ -621,14 +624,22 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     std::vector<uint8_t> shown;              // T ids the views show
     std::vector<std::vector<int64_t>> legs;  // cells of the path to each view (from the one before)
     double target_time = std::numeric_limits<double>::infinity();  // when target_share is shown
+    double early_time = std::numeric_limits<double>::infinity();   // ... and early_share
+    // What the schedule is chosen for: both of the evaluator's times (Time_r at early_share,
+    // Time_95 at target_share), so the oracle bounds both.
+    double score() const { return early_time + target_time; }
     double exponent = 0.0;
     bool toured = false;
+    bool improved = false;  // reordered by the model's times (3b)
+    double before = 0.0;    // s, its score before that
   };
   const auto want = static_cast<int64_t>(std::ceil(
       std::min(static_cast<double>(observable),
                std::max(oc.first_pass * static_cast<double>(observable),
                         oc.target_share * static_cast<double>(m.targets.size())))));
   const auto target = static_cast<int64_t>(std::ceil(oc.target_share * static_cast<double>(m.targets.size())));
+  const auto early =
+      static_cast<int64_t>(std::ceil(std::min(oc.early_share, oc.target_share) * static_cast<double>(m.targets.size())));
   // The candidate nearest a cell (within the lattice's pitch), -1 when none: what the camera sees
   // on the way is modelled by what the candidates it passes see.
   std::unordered_map<int64_t, std::vector<int>> lattice;
@@ -665,11 +676,14 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   auto time_to_target = [&](Schedule& sc) {
     std::vector<uint8_t> seen(m.targets.size(), 0);
     int64_t have = 0;
-    sc.target_time = std::numeric_limits<double>::infinity();
-    auto show = [&](int g, int b) {
+    sc.target_time = sc.early_time = std::numeric_limits<double>::infinity();
+    // Shows view (g, b) at time t; true once the target share is shown.
+    auto show = [&](int g, int b, double t) {
       source.elements(g, els);
       for (const MaskedElement& e : els)
         if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++have;
+      if (have >= early && !(sc.early_time < std::numeric_limits<double>::infinity())) sc.early_time = t;
+      if (have >= target) sc.target_time = t;
       return have >= target;
     };
     double yaw0 = start_yaw, t0 = 0.0;
@@ -687,16 +701,10 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           next = arc[i] + 0.5;
           const double f = arc[i] / total;
           const int g = nearest_candidate(cells[i]);
-          if (g >= 0 && show(g, bin_of(yaw0 + f * turn))) {
-            sc.target_time = t0 + f * (t1 - t0);
-            return;
-          }
+          if (g >= 0 && show(g, bin_of(yaw0 + f * turn), t0 + f * (t1 - t0))) return;
         }
       }
-      if (show(sc.views[q].first, sc.views[q].second)) {
-        sc.target_time = t1;
-        return;
-      }
+      if (show(sc.views[q].first, sc.views[q].second, t1)) return;
       yaw0 = yaw1;
       t0 = t1;
     }
@@ -820,15 +828,140 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     time_to_target(sc);
     return sc;
   };
+  // 3b. Each schedule's order improved for what it is for: Or-opt, 2-opt and dropping moves
+  // (improve_order) judged by the same model's time to target_share of T, from the start. The
+  // shortest tour through a walk's views may leave its largest view for last, the walk may take
+  // small views near the vehicle before a large one across the flat (env2 at 3b6d6b3: 46 % to
+  // 51 % of T in 17 s before the room that holds 40 %).
+  auto improve = [&](Schedule& best) {
+    if (best.views.size() < 2 || oc.improve_evaluations <= 0) return;
+    const std::vector<std::pair<int, int>>& nodes = best.views;
+    const size_t k = nodes.size();
+    std::vector<int64_t> cells{s};
+    std::vector<int> vbin{-1};
+    std::vector<double> yaws{start_yaw};
+    for (const auto& [g, b] : nodes) {
+      cells.push_back(m.candidates[static_cast<size_t>(g)]);
+      vbin.push_back(b);
+      yaws.push_back(yaw_of(b));
+    }
+    // Per leg a -> b: its time, its length and what the camera sees on the way (the candidate
+    // nearest the path every 0.5 m, at the yaw turning linearly in arc length), as in
+    // time_to_target.
+    struct Sample {
+      int g, bin;
+      double f;
+    };
+    const size_t nn = k + 1;
+    std::vector<double> leg_time(nn * nn, 0.0), leg_len(nn * nn, 0.0);
+    std::vector<std::vector<Sample>> leg_samples(nn * nn);
+    std::vector<std::vector<int64_t>> leg_cells(nn * nn);
+    {
+      std::vector<float> len;
+      std::vector<int32_t> parent;
+      std::vector<int64_t> wanted(cells.begin(), cells.end());
+      for (size_t a = 0; a < nn; ++a) {
+        m.search(cells[a], -1, len, &parent, &wanted);
+        for (size_t b = 1; b < nn; ++b) {
+          if (a == b) continue;
+          const size_t ab = a * nn + b;
+          const float l = len[static_cast<size_t>(cells[b])];
+          leg_len[ab] = l < kUnreached ? l : 1e6;
+          leg_time[ab] = travel_time(leg_len[ab], yaws[a], yaws[b], config_.cost);
+          if (cells[a] == cells[b] || !(l < kUnreached)) continue;
+          leg_cells[ab] = cell_path(cells[a], cells[b], parent);
+          const std::vector<int64_t>& pc = leg_cells[ab];
+          std::vector<double> arc{0.0};
+          for (size_t i = 1; i < pc.size(); ++i) arc.push_back(arc.back() + (m.centre(pc[i]) - m.centre(pc[i - 1])).norm());
+          const double total = arc.back(), turn = core::wrap_angle(yaws[b] - yaws[a]);
+          double next = 0.5;
+          for (size_t i = 1; i + 1 < pc.size() && total > 0; ++i) {
+            if (arc[i] < next) continue;
+            next = arc[i] + 0.5;
+            const double f = arc[i] / total;
+            const int g = nearest_candidate(pc[i]);
+            if (g >= 0) leg_samples[ab].push_back({g, bin_of(yaws[a] + f * turn), f});
+          }
+        }
+      }
+    }
+    std::vector<uint32_t> stamp(m.targets.size(), 0);
+    uint32_t gen = 0;
+    std::vector<MaskedElement> tmp;
+    auto view_of = [&](int g) -> const std::vector<MaskedElement>& {
+      if (cached[static_cast<size_t>(g)]) return cache[static_cast<size_t>(g)];
+      m.cast(m.candidates[static_cast<size_t>(g)], tmp);
+      return tmp;
+    };
+    const auto objective = [&](const std::vector<int>& order) {
+      ++gen;
+      int64_t have = 0;
+      double early_at = std::numeric_limits<double>::infinity();
+      auto show = [&](int g, int b, double t) {
+        for (const MaskedElement& e : view_of(g))
+          if ((e.members >> b & 1u) && stamp[static_cast<size_t>(e.element)] != gen)
+            stamp[static_cast<size_t>(e.element)] = gen, ++have;
+        if (have >= early && !(early_at < std::numeric_limits<double>::infinity())) early_at = t;
+        return have >= target;
+      };
+      double clock = 0.0;
+      size_t prev = 0;
+      for (int v : order) {
+        const size_t ab = prev * nn + static_cast<size_t>(v);
+        const double t1 = clock + leg_time[ab];
+        for (const Sample& q : leg_samples[ab]) {
+          const double t = clock + q.f * (t1 - clock);
+          if (show(q.g, q.bin, t)) return early_at + t;
+        }
+        if (show(nodes[static_cast<size_t>(v) - 1].first, vbin[static_cast<size_t>(v)], t1)) return early_at + t1;
+        clock = t1;
+        prev = static_cast<size_t>(v);
+      }
+      return std::numeric_limits<double>::infinity();
+    };
+    std::vector<int> order(k);
+    for (size_t i = 0; i < k; ++i) order[i] = static_cast<int>(i + 1);
+    const double before = objective(order);
+    const std::vector<int> better = improve_order(order, objective, oc.improve_evaluations, true);
+    const double after = objective(better);
+    if (after < before - 1e-9) {
+      Schedule sc;
+      sc.exponent = best.exponent;
+      sc.toured = best.toured;
+      sc.improved = true;
+      sc.shown.assign(m.targets.size(), 0);
+      double clock = 0.0;
+      size_t prev = 0;
+      for (int v : better) {
+        const size_t ab = prev * nn + static_cast<size_t>(v);
+        clock += leg_time[ab];
+        const std::pair<int, int> view = nodes[static_cast<size_t>(v) - 1];
+        sc.views.push_back(view);
+        sc.arrival.push_back(clock);
+        sc.leg_length.push_back(leg_len[ab]);
+        sc.legs.push_back(leg_cells[ab]);
+        source.elements(view.first, els);
+        for (const MaskedElement& e : els)
+          if (e.members >> view.second & 1u) sc.shown[static_cast<size_t>(e.element)] = 1;
+        prev = static_cast<size_t>(v);
+      }
+      time_to_target(sc);
+      sc.before = best.score();
+      best = std::move(sc);
+    }
+  };
   Schedule best;
   if (want > 0) {
     for (double e : {0.5, 1.0}) {
       Schedule w = walk_with(e);
       Schedule t = toured(w);
+      improve(w);
+      improve(t);
       for (Schedule* sc : {&w, &t})
-        if (best.views.empty() || sc->target_time < best.target_time - 1e-9) best = std::move(*sc);
+        if (best.views.empty() || sc->score() < best.score() - 1e-9) best = std::move(*sc);
     }
   }
+  summary_.first_pass_before_improvement = best.before;
   std::vector<std::pair<int, int>>& walk = best.views;
   std::vector<uint8_t> shown = best.shown;
   if (shown.empty()) shown.assign(m.targets.size(), 0);
@@ -836,7 +969,9 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   if (!walk.empty()) summary_.tour_time += best.arrival.back();
   summary_.first_pass_exponent = best.exponent;
   summary_.first_pass_toured = best.toured;
+  summary_.first_pass_improved = best.improved;
   summary_.first_pass_target_time = best.target_time;
+  summary_.first_pass_early_time = best.early_time;
 
   // 4. The cover of the rest: greedy picks until cover_fraction of the observable part is shown,
   // what the first pass showed counting.

@@ -206,6 +206,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("exact_tour_max", c.oracle.exact_tour_max, 0, 16);
   o.get("first_pass", c.oracle.first_pass, 0.0, 1.0);
   o.get("target_share", c.oracle.target_share, 0.0, 1.0);
+  o.get("early_share", c.oracle.early_share, 0.0, 1.0);
+  o.get("improve_evaluations", c.oracle.improve_evaluations, 0, 1000000);
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
   o.get("chain", c.oracle.chain, 1, 1000);
   o.get("cache_mb", c.oracle.cache_mb, 0, 1 << 20);

@@ -185,4 +185,54 @@ double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector
   return c;
 }
 
+std::vector<int> improve_order(std::vector<int> order, const std::function<double(const std::vector<int>&)>& objective,
+                               int max_evaluations, bool may_drop) {
+  int evaluations = 1;
+  double best = objective(order);
+  // Tries a candidate order; keeps it when it is better.
+  auto better = [&](std::vector<int>&& cand) {
+    if (evaluations >= max_evaluations) return false;
+    ++evaluations;
+    const double v = objective(cand);
+    if (v < best - 1e-9) {
+      best = v;
+      order = std::move(cand);
+      return true;
+    }
+    return false;
+  };
+  bool improved = true;
+  while (improved && evaluations < max_evaluations) {
+    improved = false;
+    const size_t n = order.size();
+    if (may_drop)
+      for (size_t i = 0; i < order.size() && !improved; ++i) {
+        std::vector<int> c = order;
+        c.erase(c.begin() + static_cast<std::ptrdiff_t>(i));
+        improved = better(std::move(c));
+      }
+    for (size_t len = 1; len <= 3 && !improved; ++len)
+      for (size_t i = 0; i + len <= n && !improved; ++i) {
+        // The segment [i, i + len) moved to before position j of what is left.
+        std::vector<int> seg(order.begin() + static_cast<std::ptrdiff_t>(i),
+                             order.begin() + static_cast<std::ptrdiff_t>(i + len));
+        std::vector<int> rest = order;
+        rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i), rest.begin() + static_cast<std::ptrdiff_t>(i + len));
+        for (size_t j = 0; j <= rest.size() && !improved; ++j) {
+          if (j == i) continue;
+          std::vector<int> c = rest;
+          c.insert(c.begin() + static_cast<std::ptrdiff_t>(j), seg.begin(), seg.end());
+          improved = better(std::move(c));
+        }
+      }
+    for (size_t i = 0; i + 1 < n && !improved; ++i)
+      for (size_t j = i + 2; j <= n && !improved; ++j) {
+        std::vector<int> c = order;
+        std::reverse(c.begin() + static_cast<std::ptrdiff_t>(i), c.begin() + static_cast<std::ptrdiff_t>(j));
+        improved = better(std::move(c));
+      }
+  }
+  return order;
+}
+
 }  // namespace semx::planner

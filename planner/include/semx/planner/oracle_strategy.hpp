@@ -56,7 +56,10 @@ struct OracleSummary {
   int64_t first_pass = 0;   // viewpoints of the first tour (oracle.first_pass), the rest in the second
   double first_pass_exponent = 0.0;  // the e of its ratio, and whether it is flown as a tour
   bool first_pass_toured = false;
+  bool first_pass_improved = false;             // reordered by the model's time to the target share
+  double first_pass_before_improvement = 0.0;  // s, the model's two times summed before that
   double first_pass_target_time = 0.0;  // s, when it shows oracle.target_share of T by the model
+  double first_pass_early_time = 0.0;   // s, ... oracle.early_share
   double tour_time = 0.0;    // s, the tour's summed leg costs
   double tour_length = 0.0;  // m
   bool tour_exact = false;

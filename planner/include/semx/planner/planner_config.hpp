@@ -361,6 +361,12 @@ struct OracleConfig {
   // with e = 0.5 walked alone, DEP 119 s (docs/planner.md, "The known-map oracle").
   double first_pass = 0.9;
   double target_share = 0.95;  // of T: the evaluator's Time_95
+  // ... and the share of the evaluator's Time_r: the schedule is chosen (and reordered) for the
+  // sum of the model's times to the two shares, so that it bounds both.
+  double early_share = 0.85;
+  // Objectives the first pass's reordering (Or-opt, 2-opt, drops judged by the model's time to
+  // target_share of T) may ask for; 0: the schedule as chosen.
+  int improve_evaluations = 3000;
   int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
   // Viewpoints one path flies through at most: on past a viewpoint while the turn into it takes
   // no longer than the flight (the heading keeps up), so the vehicle does not stop at each; 1:

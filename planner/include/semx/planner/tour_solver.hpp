@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace semx::planner {
@@ -39,5 +40,14 @@ Tour heuristic_open_tour(const TourProblem& p, int first = -1);
 Tour solve_tour(const std::vector<std::vector<double>>& cost, int exact_max);
 // The summed cost of consecutive pairs of `order`.
 double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector<int>& order);
+
+// Local search on the order of a route's stops for an objective only the caller can evaluate
+// (the known-map oracle: the modelled time at which the stops have shown a quota of T, which a
+// shortest tour does not minimise: it may leave the largest view for last). Moves, first
+// improvement, until none improves or `max_evaluations` objectives were asked for: a segment of
+// 1-3 stops moved elsewhere (Or-opt), a segment reversed (2-opt), and with `may_drop` a stop
+// removed. Lower is better; the result is never worse than `order`.
+std::vector<int> improve_order(std::vector<int> order, const std::function<double(const std::vector<int>&)>& objective,
+                               int max_evaluations, bool may_drop);
 
 }  // namespace semx::planner
