@@ -25,6 +25,10 @@ enum class PlannerKind {
   // DEP's roadmap with what the semantic map says about rooms: a door region is a room's
   // boundary, and the rules of RoomConfig order the goals by room (semantic_room_strategy.hpp).
   kSemanticRoom,
+  // FUEL's frontier-cluster tour with what the semantic map says about rooms: a leg that passes a
+  // door costs extra, so the tour finishes a room before it crosses a door
+  // (semantic_fuel_strategy.hpp).
+  kSemanticFuel,
   // NOT an exploration method: reads the world's ground truth and flies a precomputed tour of
   // viewpoints that sees it (oracle_strategy.hpp), the physical-limit reference of the bench.
   kOracle,
@@ -186,6 +190,26 @@ struct RoomConfig {
   bool boundary_gain = false;
   // The paper's Eq. 6 reward on top (as semantic-dep); false: G / T_path alone.
   bool eq6_reward = true;
+};
+
+// semantic-fuel (semantic_fuel_strategy.hpp; docs/planner.md, "semantic-fuel"): FUEL's tour with
+// what the semantic map knows. Rooms: a site's room is the last door region its coarse path from
+// the vehicle passes within door_radius of (none: the vehicle's room).
+struct SemanticFuelConfig {
+  double door_radius = 1.0;  // m, horizontal (and within door_height vertically)
+  double door_height = 1.5;  // m
+  // s added to a tour leg that changes room (and to the first leg into another room): the tour
+  // then changes room as few times as it can; 0: FUEL's tour.
+  double door_cost = 0.0;
+  // Object pockets: a frontier cluster too small for FUEL's tour (below fuel.major_cluster_voxels
+  // or fuel.major_coverage) whose mean lies within object_margin of the box of an object region not
+  // yet fully observed (centroid and extent) is toured with the large clusters, while the vehicle
+  // is in its room, instead of after all of them. false: FUEL's order.
+  bool object_pockets = true;
+  double object_margin = 0.5;  // m
+  // ... and only while the cluster's mean is within this of the vehicle (m; 0: wherever it is):
+  // pockets are taken on the way, not flown to across the room.
+  double object_reach = 0.0;
 };
 
 // The main loop: when to replan, when to give up.
@@ -373,7 +397,7 @@ struct OracleConfig {
 };
 
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room | semantic-fuel
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -389,6 +413,7 @@ struct PlannerConfig {
   FuelConfig fuel;
   OracleConfig oracle;
   RoomConfig room;
+  SemanticFuelConfig semantic_fuel;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };

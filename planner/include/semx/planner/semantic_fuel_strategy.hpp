@@ -1,0 +1,47 @@
+// semantic-fuel: FUEL's frontier-cluster tour (fuel_strategy.hpp) with what the semantic map
+// knows and the frontier does not (SemanticFuelConfig):
+//  - object pockets (object_pockets): FUEL tours clusters below its size thresholds only after
+//    every large one, so the unknown voxels under a table or on top of a cabinet are fetched in
+//    the end game, a room at a time. A small cluster at an object that is not fully observed yet
+//    (the region's box, grown by object_margin) is toured with the large ones: collected while the
+//    vehicle is in its room;
+//  - rooms (door_cost, off: it lost): a door region is where one room ends; every tour leg from one
+//    room to another costs door_cost seconds more, so the tour changes room as few times as it
+//    can. A site's room is the last door its coarse path from the vehicle passes (door_rooms());
+//    sites whose path passes no door are in the vehicle's room.
+// Everything else is FUEL's, unchanged.
+#pragma once
+
+#include <vector>
+
+#include "semx/planner/fuel_strategy.hpp"
+
+namespace semx::planner {
+
+class SemanticFuelStrategy : public FuelStrategy {
+ public:
+  explicit SemanticFuelStrategy(const PlannerConfig& config);
+
+ protected:
+  void add_tour_costs(const PlanContext& ctx, const GridSearch& tree, const std::vector<Eigen::Vector3d>& reps,
+                      TourProblem& problem) const override;
+  bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
+
+ private:
+  SemanticFuelConfig rules_;
+};
+
+// For each path (vehicle first), the index into `regions` of the last door region it passes
+// within `radius` horizontally and `height` vertically, or -1 when it passes none.
+std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
+                            const std::vector<SemanticRegion>& regions, double radius, double height);
+
+// Whether `p` lies within `margin` of the box of an object region (not a door, not structural) that
+// is still active (not fully observed) and has an extent.
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double margin);
+
+// Adds `cost` to every leg of `problem` (node 0 the vehicle, in room -1) between different rooms
+// (`room[i]` is node i + 1's).
+void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem);
+
+}  // namespace semx::planner

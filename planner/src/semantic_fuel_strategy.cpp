@@ -1,0 +1,74 @@
+#include "semx/planner/semantic_fuel_strategy.hpp"
+
+#include <cmath>
+
+#include "semx/runtime/semantic_classes.hpp"
+
+namespace semx::planner {
+
+SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
+    : FuelStrategy(config), rules_(config.semantic_fuel) {}
+
+std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
+                            const std::vector<SemanticRegion>& regions, double radius, double height) {
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  std::vector<int> doors;
+  for (size_t r = 0; r < regions.size(); ++r) {
+    // A door stays a room's boundary once its leaf is fully observed (active only says it was seen).
+    if (regions[r].class_id == door && regions[r].centroid.allFinite()) doors.push_back(static_cast<int>(r));
+  }
+  std::vector<int> room(paths.size(), -1);
+  const double r2 = radius * radius;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (const Eigen::Vector3d& p : paths[i]) {
+      for (int d : doors) {
+        const Eigen::Vector3d& c = regions[static_cast<size_t>(d)].centroid;
+        if ((p - c).head<2>().squaredNorm() <= r2 && std::abs(p.z() - c.z()) <= height) room[i] = d;
+      }
+    }
+  }
+  return room;
+}
+
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double margin) {
+  for (const SemanticRegion& r : regions) {
+    const auto cls = runtime::class_from_id(r.class_id);
+    if (!cls || *cls == runtime::SemanticClass::kDoor || runtime::class_info(*cls).structural) continue;
+    if (!r.active || !r.centroid.allFinite() || !r.extent.allFinite() || !(r.extent.minCoeff() > 0)) continue;
+    const Eigen::Vector3d half = 0.5 * r.extent + Eigen::Vector3d::Constant(margin);
+    if (((p - r.centroid).cwiseAbs().array() <= half.array()).all()) return true;
+  }
+  return false;
+}
+
+void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem) {
+  const size_t n = static_cast<size_t>(problem.n);
+  auto of = [&](size_t node) { return node == 0 ? -1 : room[node - 1]; };
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 1; j < n; ++j) {
+      if (i != j && of(i) != of(j)) problem.cost[i * n + j] += cost;
+    }
+  }
+}
+
+void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
+                                          const std::vector<Eigen::Vector3d>& reps, TourProblem& problem) const {
+  if (!ctx.regions || ctx.regions->empty() || !(rules_.door_cost > 0)) return;
+  std::vector<std::vector<Eigen::Vector3d>> paths;
+  paths.reserve(reps.size());
+  for (const Eigen::Vector3d& p : reps) paths.push_back(tree.tree_path(p));
+  add_room_change_cost(door_rooms(paths, *ctx.regions, rules_.door_radius, rules_.door_height), rules_.door_cost,
+                       problem);
+}
+
+}  // namespace semx::planner
+
+namespace semx::planner {
+
+bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const {
+  if (!rules_.object_pockets || !ctx.regions) return false;
+  if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach) return false;
+  return near_unfinished_object(cluster.mean, *ctx.regions, rules_.object_margin);
+}
+
+}  // namespace semx::planner
