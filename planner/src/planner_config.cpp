@@ -228,6 +228,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   sf.get("object_pockets", c.semantic_fuel.object_pockets);
   sf.get("object_margin", c.semantic_fuel.object_margin, 0.0, 10.0);
   sf.get("object_reach", c.semantic_fuel.object_reach, 0.0, 1e3);
+  sf.get("start_turns", c.semantic_fuel.start_turns, 0, 16);
 }
 
 }  // namespace semx::planner

@@ -2,12 +2,14 @@
 
 #include <cmath>
 
+#include "semx/core/angles.hpp"
+
 #include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
 
 SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
-    : FuelStrategy(config), rules_(config.semantic_fuel) {}
+    : FuelStrategy(config), rules_(config.semantic_fuel), yaw_rate_(config.cost.yaw_rate) {}
 
 std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
                             const std::vector<SemanticRegion>& regions, double radius, double height) {
@@ -69,6 +71,42 @@ bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierCluste
   if (!rules_.object_pockets || !ctx.regions) return false;
   if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach) return false;
   return near_unfinished_object(cluster.mean, *ctx.regions, rules_.object_margin);
+}
+
+}  // namespace semx::planner
+
+namespace semx::planner {
+
+void SemanticFuelStrategy::reset() {
+  FuelStrategy::reset();
+  turns_done_ = 0;
+  turn_ = Goal();
+}
+
+PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
+  if (turns_done_ < rules_.start_turns) {
+    if (turn_.valid && !ctx.need_goal) {
+      PlanOutcome o;
+      o.goal = turn_;
+      return o;
+    }
+    if (turn_.valid) ++turns_done_;
+    if (turns_done_ < rules_.start_turns) {
+      turn_ = Goal();
+      turn_.valid = true;
+      turn_.position = ctx.pose.position;
+      turn_.yaw = core::wrap_angle(ctx.pose.yaw + 2.0 * core::kPi / rules_.start_turns);
+      turn_.gain = 1.0;
+      turn_.cost = 2.0 * core::kPi / rules_.start_turns / yaw_rate_;
+      turn_.score = turn_.gain / turn_.cost;
+      turn_.waypoints = {ctx.pose.position};
+      turn_.yaws = {turn_.yaw};
+      PlanOutcome o;
+      o.goal = turn_;
+      return o;
+    }
+  }
+  return FuelStrategy::plan(ctx);
 }
 
 }  // namespace semx::planner

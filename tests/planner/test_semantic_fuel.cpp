@@ -106,6 +106,39 @@ TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
   }
 }
 
+TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
+  PocketScene s;
+  s.config.semantic_fuel.start_turns = 3;
+  SemanticFuelStrategy sem(s.config);
+  PlanContext ctx;
+  ctx.grid = &s.grid;
+  ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+  ctx.pose.yaw = 0.0;
+  ctx.regions = &s.regions;
+  ctx.frontiers = &s.frontiers;
+  ctx.rng = &s.rng;
+  ctx.counters = &s.counters;
+  double yaw = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    ctx.cycle = 2 * k + 1;
+    ctx.need_goal = true;
+    const Goal g = sem.plan(ctx).goal;
+    ASSERT_TRUE(g.valid);
+    EXPECT_EQ(g.position, ctx.pose.position) << "a turn in place";
+    EXPECT_NEAR(core::yaw_distance(g.yaw, yaw + 2.0 * core::kPi / 3.0), 0.0, 1e-9);
+    ctx.cycle = 2 * k + 2;
+    ctx.need_goal = false;  // not there yet: the same turn
+    EXPECT_EQ(sem.plan(ctx).goal.yaw, g.yaw);
+    yaw = g.yaw;
+    ctx.pose.yaw = yaw;
+  }
+  ctx.cycle = 7;
+  ctx.need_goal = true;
+  const Goal tour = sem.plan(ctx).goal;
+  ASSERT_TRUE(tour.valid);
+  EXPECT_GT((tour.position - ctx.pose.position).norm(), 0.3) << "then FUEL's tour";
+}
+
 TEST(SemanticFuel, NearAnUnfinishedObjectIsWithinItsBoxAndMargin) {
   SemanticRegion r;
   r.class_id = static_cast<int>(runtime::SemanticClass::kTable);

@@ -210,6 +210,9 @@ struct SemanticFuelConfig {
   // ... and only while the cluster's mean is within this of the vehicle (m; 0: wherever it is):
   // pockets are taken on the way, not flown to across the room.
   double object_reach = 0.0;
+  // Turns in place at the start (each 2 pi / start_turns), before the first tour: DEP's first
+  // goals look around the start, FUEL's fly to the nearest cluster. 0: FUEL's start.
+  int start_turns = 0;
 };
 
 // The main loop: when to replan, when to give up.

@@ -22,6 +22,9 @@ class SemanticFuelStrategy : public FuelStrategy {
  public:
   explicit SemanticFuelStrategy(const PlannerConfig& config);
 
+  PlanOutcome plan(PlanContext& ctx) override;
+  void reset() override;
+
  protected:
   void add_tour_costs(const PlanContext& ctx, const GridSearch& tree, const std::vector<Eigen::Vector3d>& reps,
                       TourProblem& problem) const override;
@@ -29,6 +32,9 @@ class SemanticFuelStrategy : public FuelStrategy {
 
  private:
   SemanticFuelConfig rules_;
+  double yaw_rate_;
+  int turns_done_ = 0;
+  Goal turn_;  // the turn in place being flown (start_turns)
 };
 
 // For each path (vehicle first), the index into `regions` of the last door region it passes
