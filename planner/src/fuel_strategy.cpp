@@ -359,9 +359,12 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       }
     }
     {
-      std::vector<Eigen::Vector3d> reps;
-      for (int i = 0; i < n - 1; ++i) reps.push_back(rep_view(i).position);
-      add_tour_costs(ctx, search_, reps, problem);
+      std::vector<Eigen::Vector3d> reps, means;
+      for (int i = 0; i < n - 1; ++i) {
+        reps.push_back(rep_view(i).position);
+        means.push_back(clusters_.find(sites_[static_cast<size_t>(i)].cluster)->mean);
+      }
+      add_tour_costs(ctx, search_, reps, means, problem);
     }
     core::Stopwatch tw;
     const Tour tour = solve_open_tour(problem, f.exact_tour_max);

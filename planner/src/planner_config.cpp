@@ -229,6 +229,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   sf.get("object_margin", c.semantic_fuel.object_margin, 0.0, 10.0);
   sf.get("object_reach", c.semantic_fuel.object_reach, 0.0, 1e3);
   sf.get("start_turns", c.semantic_fuel.start_turns, 0, 16);
+  sf.get("doorway_first_cost", c.semantic_fuel.doorway_first_cost, 0.0, 1e6);
+  sf.get("doorway_radius", c.semantic_fuel.doorway_radius, 0.0, 10.0);
 }
 
 }  // namespace semx::planner

@@ -1,5 +1,6 @@
 #include "semx/planner/semantic_fuel_strategy.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "semx/core/angles.hpp"
@@ -53,9 +54,30 @@ void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem
   }
 }
 
+void add_doorway_first_cost(const std::vector<bool>& doorway, double cost, TourProblem& problem) {
+  if (std::none_of(doorway.begin(), doorway.end(), [](bool d) { return d; })) return;
+  for (size_t j = 0; j < doorway.size(); ++j) {
+    if (!doorway[j]) problem.cost[j + 1] += cost;
+  }
+}
+
 void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
-                                          const std::vector<Eigen::Vector3d>& reps, TourProblem& problem) const {
-  if (!ctx.regions || ctx.regions->empty() || !(rules_.door_cost > 0)) return;
+                                          const std::vector<Eigen::Vector3d>& reps,
+                                          const std::vector<Eigen::Vector3d>& means, TourProblem& problem) const {
+  if (!ctx.regions || ctx.regions->empty()) return;
+  if (rules_.doorway_first_cost > 0) {
+    const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+    std::vector<bool> doorway(means.size(), false);
+    const double r2 = rules_.doorway_radius * rules_.doorway_radius;
+    for (size_t i = 0; i < means.size(); ++i) {
+      for (const SemanticRegion& r : *ctx.regions) {
+        if (r.class_id == door && r.centroid.allFinite() && (means[i] - r.centroid).head<2>().squaredNorm() <= r2)
+          doorway[i] = true;
+      }
+    }
+    add_doorway_first_cost(doorway, rules_.doorway_first_cost, problem);
+  }
+  if (!(rules_.door_cost > 0)) return;
   std::vector<std::vector<Eigen::Vector3d>> paths;
   paths.reserve(reps.size());
   for (const Eigen::Vector3d& p : reps) paths.push_back(tree.tree_path(p));

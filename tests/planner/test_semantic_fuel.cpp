@@ -182,5 +182,20 @@ TEST(SemanticFuel, ALegBetweenRoomsCostsTheDoorCost) {
   EXPECT_EQ(p.cost[1 * 4 + 0], 1.0);  // returns are free and stay so
 }
 
+TEST(SemanticFuel, ADoorwayFirstCostsTheFirstLegIntoOtherSitesOnlyWhileADoorwayIsLeft) {
+  TourProblem p;
+  p.n = 3;
+  p.cost.assign(9, 1.0);
+  add_doorway_first_cost({true, false}, 20.0, p);
+  EXPECT_EQ(p.cost[1], 1.0);   // into the doorway
+  EXPECT_EQ(p.cost[2], 21.0);  // into the other site first
+  EXPECT_EQ(p.cost[1 * 3 + 2], 1.0) << "legs after the first are FUEL's";
+  TourProblem q;
+  q.n = 3;
+  q.cost.assign(9, 1.0);
+  add_doorway_first_cost({false, false}, 20.0, q);
+  EXPECT_EQ(q.cost, std::vector<double>(9, 1.0)) << "no doorway: FUEL's tour";
+}
+
 }  // namespace
 }  // namespace semx::planner

@@ -213,6 +213,12 @@ struct SemanticFuelConfig {
   // Turns in place at the start (each 2 pi / start_turns), before the first tour: DEP's first
   // goals look around the start, FUEL's fly to the nearest cluster. 0: FUEL's start.
   int start_turns = 0;
+  // Doorways first: a door region means a room behind it. While a cluster lies within
+  // doorway_radius (horizontally) of a door region, the tour's first leg into any other cluster
+  // costs doorway_first_cost s more, so the vehicle looks into the room behind a door before it
+  // finishes what is around it. 0: off.
+  double doorway_first_cost = 0.0;
+  double doorway_radius = 1.5;  // m
 };
 
 // The main loop: when to replan, when to give up.
