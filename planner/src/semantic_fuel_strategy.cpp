@@ -10,7 +10,9 @@
 namespace semx::planner {
 
 SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
-    : FuelStrategy(config), rules_(config.semantic_fuel), yaw_rate_(config.cost.yaw_rate) {}
+    : FuelStrategy(config), rules_(config.semantic_fuel), yaw_rate_(config.cost.yaw_rate) {
+  if (rules_.dep_first_s > 0) dep_ = std::make_unique<DepStrategy>(config, false);
+}
 
 std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
                             const std::vector<SemanticRegion>& regions, double radius, double height) {
@@ -101,11 +103,51 @@ namespace semx::planner {
 
 void SemanticFuelStrategy::reset() {
   FuelStrategy::reset();
+  if (dep_) dep_->reset();
   turns_done_ = 0;
   turn_ = Goal();
+  first_utime_ = -1;
+  dep_now_ = false;
+}
+
+void SemanticFuelStrategy::on_map_changes(const std::vector<map::VoxelChange>& changes) {
+  FuelStrategy::on_map_changes(changes);
+  if (dep_) dep_->on_map_changes(changes);
+}
+
+void SemanticFuelStrategy::on_map_reset() {
+  FuelStrategy::on_map_reset();
+  if (dep_) dep_->on_map_reset();
+}
+
+void SemanticFuelStrategy::on_gain_invalidated(const std::vector<map::VoxelKey>& keys) {
+  FuelStrategy::on_gain_invalidated(keys);
+  if (dep_) dep_->on_gain_invalidated(keys);
+}
+
+std::optional<double> SemanticFuelStrategy::goal_score(PlanContext& ctx, const Goal& goal) {
+  if (dep_now_) return dep_->goal_score(ctx, goal);
+  return FuelStrategy::goal_score(ctx, goal);
+}
+
+void SemanticFuelStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
+  FuelStrategy::reject_goal(goal, until_cycle);
+  if (dep_) dep_->reject_goal(goal, until_cycle);
+}
+
+RoadmapView SemanticFuelStrategy::roadmap(const Goal* goal) const {
+  return dep_now_ ? dep_->roadmap(goal) : FuelStrategy::roadmap(goal);
 }
 
 PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
+  if (first_utime_ < 0) first_utime_ = ctx.pose.utime;
+  if (dep_) {
+    const bool was = dep_now_;
+    dep_now_ = 1e-6 * static_cast<double>(ctx.pose.utime - first_utime_) < rules_.dep_first_s;
+    if (dep_now_) return dep_->plan(ctx);
+    // The hand-over: FUEL plans a tour now, whatever DEP's goal was.
+    if (was) ctx.need_goal = true;
+  }
   if (turns_done_ < rules_.start_turns) {
     if (turn_.valid && !ctx.need_goal) {
       PlanOutcome o;

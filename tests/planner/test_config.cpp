@@ -119,6 +119,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(semantic_fuel.start_turns);
   SAME(semantic_fuel.doorway_first_cost);
   SAME(semantic_fuel.doorway_radius);
+  SAME(semantic_fuel.dep_first_s);
 #undef SAME
 }
 

@@ -4,6 +4,7 @@
 
 #include "planner_test_util.hpp"
 #include "semx/core/angles.hpp"
+#include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/semantic_fuel_strategy.hpp"
 #include "semx/runtime/semantic_classes.hpp"
@@ -137,6 +138,39 @@ TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
   const Goal tour = sem.plan(ctx).goal;
   ASSERT_TRUE(tour.valid);
   EXPECT_GT((tour.position - ctx.pose.position).norm(), 0.3) << "then FUEL's tour";
+}
+
+TEST(SemanticFuel, DepFirstFliesDepsGoalUntilItsTimeThenFuelsTour) {
+  auto goal = [](Strategy& s, PocketScene& scene, int64_t utime) {
+    PlanContext ctx;
+    ctx.grid = &scene.grid;
+    ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+    ctx.pose.utime = utime;
+    ctx.regions = &scene.regions;
+    ctx.frontiers = &scene.frontiers;
+    ctx.cycle = 1;
+    ctx.rng = &scene.rng;
+    ctx.counters = &scene.counters;
+    ctx.min_gain = scene.config.gain.min_gain;
+    ctx.need_goal = true;
+    return s.plan(ctx).goal;
+  };
+  PocketScene a, b, c, d;
+  DepStrategy dep(a.config, false);
+  a.config.semantic_fuel.dep_first_s = 10.0;
+  b.config.semantic_fuel.dep_first_s = 10.0;
+  SemanticFuelStrategy first(b.config);
+  const Goal g = goal(dep, a, 0);
+  ASSERT_TRUE(g.valid);
+  EXPECT_EQ(goal(first, b, 0).position, g.position) << "DEP's goal before dep_first_s";
+  FuelStrategy fuel(c.config);
+  const Goal f = goal(fuel, c, 0);
+  ASSERT_GT((f.position - g.position).norm(), 0.1) << "the scene is meant to tell DEP's goal from FUEL's";
+  d.config.semantic_fuel.dep_first_s = 10.0;
+  SemanticFuelStrategy later(d.config);
+  goal(later, d, 0);
+  d.rng = core::SplitMixRng(1);
+  EXPECT_EQ(goal(later, d, 11000000).position, f.position) << "FUEL's tour after";
 }
 
 TEST(SemanticFuel, NearAnUnfinishedObjectIsWithinItsBoxAndMargin) {

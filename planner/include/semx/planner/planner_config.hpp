@@ -219,6 +219,9 @@ struct SemanticFuelConfig {
   // finishes what is around it. 0: off.
   double doorway_first_cost = 0.0;
   double doorway_radius = 1.5;  // m
+  // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
+  // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
+  double dep_first_s = 0.0;
 };
 
 // The main loop: when to replan, when to give up.

@@ -12,8 +12,10 @@
 // Everything else is FUEL's, unchanged.
 #pragma once
 
+#include <memory>
 #include <vector>
 
+#include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/fuel_strategy.hpp"
 
 namespace semx::planner {
@@ -24,6 +26,12 @@ class SemanticFuelStrategy : public FuelStrategy {
 
   PlanOutcome plan(PlanContext& ctx) override;
   void reset() override;
+  void on_map_changes(const std::vector<map::VoxelChange>& changes) override;
+  void on_map_reset() override;
+  void on_gain_invalidated(const std::vector<map::VoxelKey>& keys) override;
+  std::optional<double> goal_score(PlanContext& ctx, const Goal& goal) override;
+  void reject_goal(const Goal& goal, int64_t until_cycle) override;
+  RoadmapView roadmap(const Goal* goal) const override;
 
  protected:
   void add_tour_costs(const PlanContext& ctx, const GridSearch& tree, const std::vector<Eigen::Vector3d>& reps,
@@ -33,6 +41,10 @@ class SemanticFuelStrategy : public FuelStrategy {
  private:
   SemanticFuelConfig rules_;
   double yaw_rate_;
+  // dep_first_s: DEP's roadmap decides until then (it is fed the map all along).
+  std::unique_ptr<DepStrategy> dep_;
+  int64_t first_utime_ = -1;
+  bool dep_now_ = false;
   int turns_done_ = 0;
   Goal turn_;  // the turn in place being flown (start_turns)
 };
