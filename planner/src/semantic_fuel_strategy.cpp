@@ -35,7 +35,8 @@ std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& pat
   return room;
 }
 
-bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double margin) {
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                            double margin) {
   for (const SemanticRegion& r : regions) {
     const auto cls = runtime::class_from_id(r.class_id);
     if (!cls || *cls == runtime::SemanticClass::kDoor || runtime::class_info(*cls).structural) continue;
@@ -65,7 +66,8 @@ void add_doorway_first_cost(const std::vector<bool>& doorway, double cost, TourP
 
 void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
                                           const std::vector<Eigen::Vector3d>& reps,
-                                          const std::vector<Eigen::Vector3d>& means, TourProblem& problem) const {
+                                          const std::vector<Eigen::Vector3d>& means,
+                                          TourProblem& problem) const {
   if (!ctx.regions || ctx.regions->empty()) return;
   if (rules_.doorway_first_cost > 0) {
     const int door = static_cast<int>(runtime::SemanticClass::kDoor);
@@ -73,7 +75,8 @@ void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSear
     const double r2 = rules_.doorway_radius * rules_.doorway_radius;
     for (size_t i = 0; i < means.size(); ++i) {
       for (const SemanticRegion& r : *ctx.regions) {
-        if (r.class_id == door && r.centroid.allFinite() && (means[i] - r.centroid).head<2>().squaredNorm() <= r2)
+        if (r.class_id == door && r.centroid.allFinite() &&
+            (means[i] - r.centroid).head<2>().squaredNorm() <= r2)
           doorway[i] = true;
       }
     }
@@ -83,8 +86,8 @@ void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSear
   std::vector<std::vector<Eigen::Vector3d>> paths;
   paths.reserve(reps.size());
   for (const Eigen::Vector3d& p : reps) paths.push_back(tree.tree_path(p));
-  add_room_change_cost(door_rooms(paths, *ctx.regions, rules_.door_radius, rules_.door_height), rules_.door_cost,
-                       problem);
+  add_room_change_cost(door_rooms(paths, *ctx.regions, rules_.door_radius, rules_.door_height),
+                       rules_.door_cost, problem);
 }
 
 }  // namespace semx::planner
@@ -93,7 +96,8 @@ namespace semx::planner {
 
 bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const {
   if (!rules_.object_pockets || !ctx.regions) return false;
-  if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach) return false;
+  if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach)
+    return false;
   return near_unfinished_object(cluster.mean, *ctx.regions, rules_.object_margin);
 }
 

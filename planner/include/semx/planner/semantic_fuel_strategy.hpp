@@ -34,8 +34,9 @@ class SemanticFuelStrategy : public FuelStrategy {
   RoadmapView roadmap(const Goal* goal) const override;
 
  protected:
-  void add_tour_costs(const PlanContext& ctx, const GridSearch& tree, const std::vector<Eigen::Vector3d>& reps,
-                      const std::vector<Eigen::Vector3d>& means, TourProblem& problem) const override;
+  void add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
+                      const std::vector<Eigen::Vector3d>& reps, const std::vector<Eigen::Vector3d>& means,
+                      TourProblem& problem) const override;
   bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
 
  private:
@@ -56,7 +57,8 @@ std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& pat
 
 // Whether `p` lies within `margin` of the box of an object region (not a door, not structural) that
 // is still active (not fully observed) and has an extent.
-bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double margin);
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                            double margin);
 
 // Adds `cost` to the first leg (from the vehicle, node 0) into every site that is not a doorway's
 // while any site is (`doorway[i]` is node i + 1's): the tour starts with a doorway.
