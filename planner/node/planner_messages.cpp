@@ -84,6 +84,7 @@ std::vector<SemanticRegion> to_regions(const semx::semantic_regions_t& m) {
     s.weight = r.weight;
     s.radius = r.radius;
     s.active = r.active != 0;
+    s.extent = Eigen::Vector3d(r.extent[0], r.extent[1], r.extent[2]);
     out.push_back(s);
   }
   return out;

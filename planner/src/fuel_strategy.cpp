@@ -320,8 +320,9 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     // FUEL-size clusters first: the smaller ones only once none of those is left.
     auto major = [&](const Site& s) {
       const FrontierClusters::Cluster* c = clusters_.find(s.cluster);
-      return c && static_cast<int64_t>(c->voxels.size()) >= f.major_cluster_voxels &&
-             state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage;
+      return c && ((static_cast<int64_t>(c->voxels.size()) >= f.major_cluster_voxels &&
+                    state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage) ||
+                   promoted(ctx, *c));
     };
     if (std::any_of(sites_.begin(), sites_.end(), major))
       sites_.erase(std::remove_if(sites_.begin(), sites_.end(), [&](const Site& s) { return !major(s); }),
@@ -356,6 +357,14 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         problem.cost[static_cast<size_t>(i + 1) * static_cast<size_t>(n) + static_cast<size_t>(j + 1)] =
             travel_time(site_distance(i, j), rep_view(i).yaw, rep_view(j).yaw, cost);
       }
+    }
+    {
+      std::vector<Eigen::Vector3d> reps, means;
+      for (int i = 0; i < n - 1; ++i) {
+        reps.push_back(rep_view(i).position);
+        means.push_back(clusters_.find(sites_[static_cast<size_t>(i)].cluster)->mean);
+      }
+      add_tour_costs(ctx, search_, reps, means, problem);
     }
     core::Stopwatch tw;
     const Tour tour = solve_open_tour(problem, f.exact_tour_max);

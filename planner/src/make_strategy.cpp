@@ -3,6 +3,7 @@
 #include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/nbv_strategy.hpp"
 #include "semx/planner/oracle_strategy.hpp"
+#include "semx/planner/semantic_fuel_strategy.hpp"
 #include "semx/planner/semantic_room_strategy.hpp"
 #include "semx/planner/strategy.hpp"
 
@@ -24,6 +25,8 @@ std::unique_ptr<Strategy> make_strategy(const PlannerConfig& config) {
       return std::make_unique<OracleStrategy>(config);
     case PlannerKind::kSemanticRoom:
       return std::make_unique<SemanticRoomStrategy>(config);
+    case PlannerKind::kSemanticFuel:
+      return std::make_unique<SemanticFuelStrategy>(config);
   }
   return nullptr;
 }

@@ -22,6 +22,8 @@ const char* to_string(PlannerKind k) {
       return "oracle";
     case PlannerKind::kSemanticRoom:
       return "semantic-room";
+    case PlannerKind::kSemanticFuel:
+      return "semantic-fuel";
   }
   return "?";
 }
@@ -34,8 +36,9 @@ PlannerKind parse_planner_kind(const std::string& name) {
   if (name == "fuel") return PlannerKind::kFuel;
   if (name == "oracle") return PlannerKind::kOracle;
   if (name == "semantic-room") return PlannerKind::kSemanticRoom;
+  if (name == "semantic-fuel") return PlannerKind::kSemanticFuel;
   throw std::invalid_argument("unknown planner '" + name +
-                              "' (semantic-dep, dep, nbv, aep, fuel, oracle, semantic-room)");
+                              "' (semantic-dep, dep, nbv, aep, fuel, oracle, semantic-room, semantic-fuel)");
 }
 
 double GainConfig::horizontal_fov() const { return 2.0 * std::atan2(0.5 * image_width, fx); }
@@ -57,7 +60,8 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room"});
+  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room",
+                                      "semantic-fuel"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 
@@ -219,6 +223,17 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   rm.get("eq6_reward", c.room.eq6_reward);
   rm.get("tour", c.room.tour);
   rm.get("boundary_gain", c.room.boundary_gain);
+  auto sf = m.child("semantic_fuel");
+  sf.get("door_radius", c.semantic_fuel.door_radius, 0.0, 10.0);
+  sf.get("door_height", c.semantic_fuel.door_height, 0.0, 10.0);
+  sf.get("door_cost", c.semantic_fuel.door_cost, 0.0, 1e6);
+  sf.get("object_pockets", c.semantic_fuel.object_pockets);
+  sf.get("object_margin", c.semantic_fuel.object_margin, 0.0, 10.0);
+  sf.get("object_reach", c.semantic_fuel.object_reach, 0.0, 1e3);
+  sf.get("start_turns", c.semantic_fuel.start_turns, 0, 16);
+  sf.get("doorway_first_cost", c.semantic_fuel.doorway_first_cost, 0.0, 1e6);
+  sf.get("doorway_radius", c.semantic_fuel.doorway_radius, 0.0, 10.0);
+  sf.get("dep_first_s", c.semantic_fuel.dep_first_s, 0.0, 1e6);
 }
 
 }  // namespace semx::planner

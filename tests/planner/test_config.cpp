@@ -110,6 +110,16 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.search_step);
   SAME(fuel.low_clearance_penalty);
   SAME(fuel.cost_budget);
+  SAME(semantic_fuel.object_pockets);
+  SAME(semantic_fuel.object_margin);
+  SAME(semantic_fuel.object_reach);
+  SAME(semantic_fuel.door_radius);
+  SAME(semantic_fuel.door_height);
+  SAME(semantic_fuel.door_cost);
+  SAME(semantic_fuel.start_turns);
+  SAME(semantic_fuel.doorway_first_cost);
+  SAME(semantic_fuel.doorway_radius);
+  SAME(semantic_fuel.dep_first_s);
 #undef SAME
 }
 
@@ -162,6 +172,7 @@ TEST(PlannerConfig, OverridesAndErrors) {
   EXPECT_THROW(parse_planner_kind("DEP"), std::invalid_argument);
   EXPECT_THROW(load_config<PlannerConfig>("", {"fuel.view_radius_max=1.0"}), ConfigError);  // below min
   EXPECT_EQ(load_config<PlannerConfig>("", {"planner=fuel"}).kind(), PlannerKind::kFuel);
+  EXPECT_EQ(load_config<PlannerConfig>("", {"planner=semantic-fuel"}).kind(), PlannerKind::kSemanticFuel);
   for (const char* name : {"semantic-dep", "dep", "nbv", "aep", "fuel"})
     EXPECT_STREQ(to_string(parse_planner_kind(name)), name);
 }

@@ -20,6 +20,7 @@ ExplorationSim::ExplorationSim(const SyntheticWorld& world, ExplorationPlanner& 
       const Box& b = world.objects()[i];
       Object o;
       o.centre = 0.5 * (b.min + b.max);
+      o.extent = b.max - b.min;
       o.class_id = world.object_classes()[i];
       o.weight = options_.semantic_weight;
       o.radius = options_.semantic_radius;
@@ -63,6 +64,7 @@ void ExplorationSim::update_regions(double t, ExplorationSimResult& r) {
     s.weight = o.weight;
     s.radius = o.radius;
     s.active = !o.completed;
+    s.extent = o.extent;
     regions.push_back(s);
   }
   if (completed > r.objects_completed && completed == static_cast<int64_t>(objects_.size()))

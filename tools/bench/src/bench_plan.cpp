@@ -18,7 +18,8 @@ namespace {
 
 // "oracle" is the known-map reference (it reads the world's ground truth); the report divides
 // the others' times by its own.
-const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room"};
+const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room",
+                                            "semantic-fuel"};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 

@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // The paper's rows, then the references: the FUEL-class baseline and the known-map oracle.
-const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "semantic-room", "fuel", "oracle"};
+const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "semantic-room", "fuel",
+                                                 "semantic-fuel", "oracle"};
 // The planner every other row is divided by in the "× oracle" table.
 const char* const kOraclePlanner = "oracle";
 

@@ -66,6 +66,20 @@ class FuelStrategy : public Strategy {
   // Why the last plan() planned again ("" when it kept the goal).
   const std::string& replan_reason() const { return replan_reason_; }
 
+ protected:
+  // A hook for planners built on FUEL's tour (semantic_fuel_strategy.hpp): extra costs (s) added to
+  // the global tour's problem before it is solved. Node 0 is the vehicle, node i + 1 the site of
+  // the i-th representative viewpoint `reps[i]`, whose cluster's mean is `means[i]`; `tree` holds
+  // the coarse search from the vehicle (tree_path()). FUEL adds nothing.
+  virtual void add_tour_costs(const PlanContext& /*ctx*/, const GridSearch& /*tree*/,
+                              const std::vector<Eigen::Vector3d>& /*reps*/,
+                              const std::vector<Eigen::Vector3d>& /*means*/, TourProblem& /*problem*/) const {}
+  // ... and a cluster below FUEL's size thresholds that the tour visits with the large ones
+  // instead of after them. FUEL promotes none.
+  virtual bool promoted(const PlanContext& /*ctx*/, const FrontierClusters::Cluster& /*cluster*/) const {
+    return false;
+  }
+
  private:
   struct ClusterState {
     std::vector<Viewpoint> views;

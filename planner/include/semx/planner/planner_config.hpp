@@ -25,6 +25,10 @@ enum class PlannerKind {
   // DEP's roadmap with what the semantic map says about rooms: a door region is a room's
   // boundary, and the rules of RoomConfig order the goals by room (semantic_room_strategy.hpp).
   kSemanticRoom,
+  // FUEL's frontier-cluster tour with what the semantic map says about rooms: a leg that passes a
+  // door costs extra, so the tour finishes a room before it crosses a door
+  // (semantic_fuel_strategy.hpp).
+  kSemanticFuel,
   // NOT an exploration method: reads the world's ground truth and flies a precomputed tour of
   // viewpoints that sees it (oracle_strategy.hpp), the physical-limit reference of the bench.
   kOracle,
@@ -186,6 +190,38 @@ struct RoomConfig {
   bool boundary_gain = false;
   // The paper's Eq. 6 reward on top (as semantic-dep); false: G / T_path alone.
   bool eq6_reward = true;
+};
+
+// semantic-fuel (semantic_fuel_strategy.hpp; docs/planner.md, "semantic-fuel"): FUEL's tour with
+// what the semantic map knows. Rooms: a site's room is the last door region its coarse path from
+// the vehicle passes within door_radius of (none: the vehicle's room).
+struct SemanticFuelConfig {
+  double door_radius = 1.0;  // m, horizontal (and within door_height vertically)
+  double door_height = 1.5;  // m
+  // s added to a tour leg that changes room (and to the first leg into another room): the tour
+  // then changes room as few times as it can; 0: FUEL's tour.
+  double door_cost = 0.0;
+  // Object pockets: a frontier cluster too small for FUEL's tour (below fuel.major_cluster_voxels
+  // or fuel.major_coverage) whose mean lies within object_margin of the box of an object region not
+  // yet fully observed (centroid and extent) is toured with the large clusters, while the vehicle
+  // is in its room, instead of after all of them. false: FUEL's order.
+  bool object_pockets = true;
+  double object_margin = 0.5;  // m
+  // ... and only while the cluster's mean is within this of the vehicle (m; 0: wherever it is):
+  // pockets are taken on the way, not flown to across the room.
+  double object_reach = 0.0;
+  // Turns in place at the start (each 2 pi / start_turns), before the first tour: DEP's first
+  // goals look around the start, FUEL's fly to the nearest cluster. 0: FUEL's start.
+  int start_turns = 0;
+  // Doorways first: a door region means a room behind it. While a cluster lies within
+  // doorway_radius (horizontally) of a door region, the tour's first leg into any other cluster
+  // costs doorway_first_cost s more, so the vehicle looks into the room behind a door before it
+  // finishes what is around it. 0: off.
+  double doorway_first_cost = 0.0;
+  double doorway_radius = 1.5;  // m
+  // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
+  // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
+  double dep_first_s = 0.0;
 };
 
 // The main loop: when to replan, when to give up.
@@ -379,7 +415,7 @@ struct OracleConfig {
 };
 
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room
+  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room | semantic-fuel
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;
@@ -395,6 +431,7 @@ struct PlannerConfig {
   FuelConfig fuel;
   OracleConfig oracle;
   RoomConfig room;
+  SemanticFuelConfig semantic_fuel;
 
   PlannerKind kind() const { return parse_planner_kind(planner); }
 };

@@ -19,6 +19,9 @@ struct SemanticRegion {
   double weight = 0.0;                                 // w_i
   double radius = 0.0;                                 // r_i, m
   bool active = true;                                  // false once fully observed
+  // The object's bounding box size (semantic_region_t.extent), m; zero when unknown. The paper's
+  // reward does not use it (semantic-fuel does).
+  Eigen::Vector3d extent = Eigen::Vector3d::Zero();
 };
 
 // The camera's horizontal view from a node: regions outside it reward nothing when one is given

@@ -1,0 +1,71 @@
+// semantic-fuel: FUEL's frontier-cluster tour (fuel_strategy.hpp) with what the semantic map
+// knows and the frontier does not (SemanticFuelConfig):
+//  - object pockets (object_pockets): FUEL tours clusters below its size thresholds only after
+//    every large one, so the unknown voxels under a table or on top of a cabinet are fetched in
+//    the end game, a room at a time. A small cluster at an object that is not fully observed yet
+//    (the region's box, grown by object_margin) is toured with the large ones: collected while the
+//    vehicle is in its room;
+//  - rooms (door_cost, off: it lost): a door region is where one room ends; every tour leg from one
+//    room to another costs door_cost seconds more, so the tour changes room as few times as it
+//    can. A site's room is the last door its coarse path from the vehicle passes (door_rooms());
+//    sites whose path passes no door are in the vehicle's room.
+// Everything else is FUEL's, unchanged.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/fuel_strategy.hpp"
+
+namespace semx::planner {
+
+class SemanticFuelStrategy : public FuelStrategy {
+ public:
+  explicit SemanticFuelStrategy(const PlannerConfig& config);
+
+  PlanOutcome plan(PlanContext& ctx) override;
+  void reset() override;
+  void on_map_changes(const std::vector<map::VoxelChange>& changes) override;
+  void on_map_reset() override;
+  void on_gain_invalidated(const std::vector<map::VoxelKey>& keys) override;
+  std::optional<double> goal_score(PlanContext& ctx, const Goal& goal) override;
+  void reject_goal(const Goal& goal, int64_t until_cycle) override;
+  RoadmapView roadmap(const Goal* goal) const override;
+
+ protected:
+  void add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
+                      const std::vector<Eigen::Vector3d>& reps, const std::vector<Eigen::Vector3d>& means,
+                      TourProblem& problem) const override;
+  bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
+
+ private:
+  SemanticFuelConfig rules_;
+  double yaw_rate_;
+  // dep_first_s: DEP's roadmap decides until then (it is fed the map all along).
+  std::unique_ptr<DepStrategy> dep_;
+  int64_t first_utime_ = -1;
+  bool dep_now_ = false;
+  int turns_done_ = 0;
+  Goal turn_;  // the turn in place being flown (start_turns)
+};
+
+// For each path (vehicle first), the index into `regions` of the last door region it passes
+// within `radius` horizontally and `height` vertically, or -1 when it passes none.
+std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
+                            const std::vector<SemanticRegion>& regions, double radius, double height);
+
+// Whether `p` lies within `margin` of the box of an object region (not a door, not structural) that
+// is still active (not fully observed) and has an extent.
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                            double margin);
+
+// Adds `cost` to the first leg (from the vehicle, node 0) into every site that is not a doorway's
+// while any site is (`doorway[i]` is node i + 1's): the tour starts with a doorway.
+void add_doorway_first_cost(const std::vector<bool>& doorway, double cost, TourProblem& problem);
+
+// Adds `cost` to every leg of `problem` (node 0 the vehicle, in room -1) between different rooms
+// (`room[i]` is node i + 1's).
+void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem);
+
+}  // namespace semx::planner

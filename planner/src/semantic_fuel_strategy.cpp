@@ -1,0 +1,180 @@
+#include "semx/planner/semantic_fuel_strategy.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "semx/core/angles.hpp"
+
+#include "semx/runtime/semantic_classes.hpp"
+
+namespace semx::planner {
+
+SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
+    : FuelStrategy(config), rules_(config.semantic_fuel), yaw_rate_(config.cost.yaw_rate) {
+  if (rules_.dep_first_s > 0) dep_ = std::make_unique<DepStrategy>(config, false);
+}
+
+std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
+                            const std::vector<SemanticRegion>& regions, double radius, double height) {
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  std::vector<int> doors;
+  for (size_t r = 0; r < regions.size(); ++r) {
+    // A door stays a room's boundary once its leaf is fully observed (active only says it was seen).
+    if (regions[r].class_id == door && regions[r].centroid.allFinite()) doors.push_back(static_cast<int>(r));
+  }
+  std::vector<int> room(paths.size(), -1);
+  const double r2 = radius * radius;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (const Eigen::Vector3d& p : paths[i]) {
+      for (int d : doors) {
+        const Eigen::Vector3d& c = regions[static_cast<size_t>(d)].centroid;
+        if ((p - c).head<2>().squaredNorm() <= r2 && std::abs(p.z() - c.z()) <= height) room[i] = d;
+      }
+    }
+  }
+  return room;
+}
+
+bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
+                            double margin) {
+  for (const SemanticRegion& r : regions) {
+    const auto cls = runtime::class_from_id(r.class_id);
+    if (!cls || *cls == runtime::SemanticClass::kDoor || runtime::class_info(*cls).structural) continue;
+    if (!r.active || !r.centroid.allFinite() || !r.extent.allFinite() || !(r.extent.minCoeff() > 0)) continue;
+    const Eigen::Vector3d half = 0.5 * r.extent + Eigen::Vector3d::Constant(margin);
+    if (((p - r.centroid).cwiseAbs().array() <= half.array()).all()) return true;
+  }
+  return false;
+}
+
+void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem) {
+  const size_t n = static_cast<size_t>(problem.n);
+  auto of = [&](size_t node) { return node == 0 ? -1 : room[node - 1]; };
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 1; j < n; ++j) {
+      if (i != j && of(i) != of(j)) problem.cost[i * n + j] += cost;
+    }
+  }
+}
+
+void add_doorway_first_cost(const std::vector<bool>& doorway, double cost, TourProblem& problem) {
+  if (std::none_of(doorway.begin(), doorway.end(), [](bool d) { return d; })) return;
+  for (size_t j = 0; j < doorway.size(); ++j) {
+    if (!doorway[j]) problem.cost[j + 1] += cost;
+  }
+}
+
+void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSearch& tree,
+                                          const std::vector<Eigen::Vector3d>& reps,
+                                          const std::vector<Eigen::Vector3d>& means,
+                                          TourProblem& problem) const {
+  if (!ctx.regions || ctx.regions->empty()) return;
+  if (rules_.doorway_first_cost > 0) {
+    const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+    std::vector<bool> doorway(means.size(), false);
+    const double r2 = rules_.doorway_radius * rules_.doorway_radius;
+    for (size_t i = 0; i < means.size(); ++i) {
+      for (const SemanticRegion& r : *ctx.regions) {
+        if (r.class_id == door && r.centroid.allFinite() &&
+            (means[i] - r.centroid).head<2>().squaredNorm() <= r2)
+          doorway[i] = true;
+      }
+    }
+    add_doorway_first_cost(doorway, rules_.doorway_first_cost, problem);
+  }
+  if (!(rules_.door_cost > 0)) return;
+  std::vector<std::vector<Eigen::Vector3d>> paths;
+  paths.reserve(reps.size());
+  for (const Eigen::Vector3d& p : reps) paths.push_back(tree.tree_path(p));
+  add_room_change_cost(door_rooms(paths, *ctx.regions, rules_.door_radius, rules_.door_height),
+                       rules_.door_cost, problem);
+}
+
+}  // namespace semx::planner
+
+namespace semx::planner {
+
+bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const {
+  if (!rules_.object_pockets || !ctx.regions) return false;
+  if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach)
+    return false;
+  return near_unfinished_object(cluster.mean, *ctx.regions, rules_.object_margin);
+}
+
+}  // namespace semx::planner
+
+namespace semx::planner {
+
+void SemanticFuelStrategy::reset() {
+  FuelStrategy::reset();
+  if (dep_) dep_->reset();
+  turns_done_ = 0;
+  turn_ = Goal();
+  first_utime_ = -1;
+  dep_now_ = false;
+}
+
+void SemanticFuelStrategy::on_map_changes(const std::vector<map::VoxelChange>& changes) {
+  FuelStrategy::on_map_changes(changes);
+  if (dep_) dep_->on_map_changes(changes);
+}
+
+void SemanticFuelStrategy::on_map_reset() {
+  FuelStrategy::on_map_reset();
+  if (dep_) dep_->on_map_reset();
+}
+
+void SemanticFuelStrategy::on_gain_invalidated(const std::vector<map::VoxelKey>& keys) {
+  FuelStrategy::on_gain_invalidated(keys);
+  if (dep_) dep_->on_gain_invalidated(keys);
+}
+
+std::optional<double> SemanticFuelStrategy::goal_score(PlanContext& ctx, const Goal& goal) {
+  if (dep_now_) return dep_->goal_score(ctx, goal);
+  return FuelStrategy::goal_score(ctx, goal);
+}
+
+void SemanticFuelStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
+  FuelStrategy::reject_goal(goal, until_cycle);
+  if (dep_) dep_->reject_goal(goal, until_cycle);
+}
+
+RoadmapView SemanticFuelStrategy::roadmap(const Goal* goal) const {
+  return dep_now_ ? dep_->roadmap(goal) : FuelStrategy::roadmap(goal);
+}
+
+PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
+  if (first_utime_ < 0) first_utime_ = ctx.pose.utime;
+  if (dep_) {
+    const bool was = dep_now_;
+    dep_now_ = 1e-6 * static_cast<double>(ctx.pose.utime - first_utime_) < rules_.dep_first_s;
+    if (dep_now_) return dep_->plan(ctx);
+    // The hand-over: FUEL plans a tour now, whatever DEP's goal was.
+    if (was) ctx.need_goal = true;
+  }
+  if (turns_done_ < rules_.start_turns) {
+    if (turn_.valid && !ctx.need_goal) {
+      PlanOutcome o;
+      o.goal = turn_;
+      return o;
+    }
+    if (turn_.valid) ++turns_done_;
+    if (turns_done_ < rules_.start_turns) {
+      turn_ = Goal();
+      turn_.valid = true;
+      turn_.position = ctx.pose.position;
+      turn_.yaw = core::wrap_angle(ctx.pose.yaw + 2.0 * core::kPi / rules_.start_turns);
+      turn_.gain = 1.0;
+      turn_.cost = 2.0 * core::kPi / rules_.start_turns / yaw_rate_;
+      turn_.score = turn_.gain / turn_.cost;
+      turn_.waypoints = {ctx.pose.position};
+      turn_.yaws = {turn_.yaw};
+      PlanOutcome o;
+      o.goal = turn_;
+      return o;
+    }
+  }
+  return FuelStrategy::plan(ctx);
+}
+
+}  // namespace semx::planner

@@ -1,0 +1,235 @@
+// semantic-fuel's rules (semantic_fuel_strategy.hpp) on a small synthetic map: where each must
+// change FUEL's goal, and where it must not.
+#include <gtest/gtest.h>
+
+#include "planner_test_util.hpp"
+#include "semx/core/angles.hpp"
+#include "semx/planner/dep_strategy.hpp"
+#include "semx/planner/fuel_strategy.hpp"
+#include "semx/planner/semantic_fuel_strategy.hpp"
+#include "semx/runtime/semantic_classes.hpp"
+
+namespace semx::planner {
+namespace {
+
+// SyntheticWorld::two_rooms (x 0-4 and 4.2-8.2, y 0-4, a doorway at y 1.4-2.6): the first room is
+// known but for a small pocket on a cabinet in its corner (a frontier cluster below FUEL's size
+// threshold), the second only its first 1.5 m. The vehicle stands in the first room, nearer the
+// pocket than the second room's frontier.
+struct PocketScene {
+  PlannerConfig config = test_config("semantic-fuel");
+  map::StateGrid grid = map::StateGrid(0.1);
+  FrontierTracker frontiers{1.0};
+  core::SplitMixRng rng{1};
+  std::vector<SemanticRegion> regions;
+  CycleCounters counters;
+  const Eigen::Vector3d pocket{0.25, 3.75, 1.0};
+
+  PocketScene() {
+    const SyntheticWorld w = SyntheticWorld::two_rooms();
+    w.reveal(grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
+    fill_m(grid, {0.0, 3.5, 0.8}, {0.5, 4.0, 1.2}, map::VoxelState::kUnknown);
+    frontiers.reset(grid);
+  }
+  // The cabinet whose top holds the pocket.
+  SemanticRegion cabinet(bool active = true) const {
+    SemanticRegion r;
+    r.class_id = static_cast<int>(runtime::SemanticClass::kCabinet);
+    r.centroid = Eigen::Vector3d(0.25, 3.75, 0.5);
+    r.extent = Eigen::Vector3d(0.5, 0.5, 1.0);
+    r.weight = 300.0;
+    r.radius = 3.0;
+    r.active = active;
+    return r;
+  }
+  // The first cluster of the plan's tour: its mean.
+  Eigen::Vector3d first_site(FuelStrategy& s) {
+    PlanContext ctx;
+    ctx.grid = &grid;
+    ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+    ctx.pose.yaw = 0.5 * core::kPi;
+    ctx.regions = &regions;
+    ctx.frontiers = &frontiers;
+    ctx.cycle = 1;
+    ctx.rng = &rng;
+    ctx.counters = &counters;
+    ctx.need_goal = true;
+    const PlanOutcome out = s.plan(ctx);
+    EXPECT_TRUE(out.goal.valid) << out.reason;
+    if (s.tour().empty()) return Eigen::Vector3d::Constant(-1e9);
+    return s.clusters().find(s.tour().front())->mean;
+  }
+  bool at_pocket(const Eigen::Vector3d& p) const { return (p - pocket).norm() < 0.6; }
+};
+
+TEST(SemanticFuel, APocketAtAnUnfinishedObjectIsToured) {
+  PocketScene s;
+  s.regions = {s.cabinet()};
+  FuelStrategy fuel(s.config);
+  const Eigen::Vector3d f = s.first_site(fuel);
+  EXPECT_GT(f.x(), 4.2) << "the scene is meant to make FUEL leave the pocket for later";
+  PocketScene t;
+  t.regions = {t.cabinet()};
+  SemanticFuelStrategy sem(t.config);
+  const Eigen::Vector3d g = t.first_site(sem);
+  EXPECT_TRUE(t.at_pocket(g)) << g.transpose();
+}
+
+TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
+  PocketScene base;
+  FuelStrategy fuel(base.config);
+  const Eigen::Vector3d f = base.first_site(fuel);
+  auto first = [](PocketScene& s) {
+    SemanticFuelStrategy sem(s.config);
+    return s.first_site(sem);
+  };
+  {  // no region at all
+    PocketScene s;
+    EXPECT_EQ(first(s), f);
+  }
+  {  // the cabinet is fully observed
+    PocketScene s;
+    s.regions = {s.cabinet(false)};
+    EXPECT_EQ(first(s), f);
+  }
+  {  // an object elsewhere
+    PocketScene s;
+    SemanticRegion far = s.cabinet();
+    far.centroid = Eigen::Vector3d(3.0, 0.5, 0.5);
+    s.regions = {far};
+    EXPECT_EQ(first(s), f);
+  }
+  {  // the rule off
+    PocketScene s;
+    s.regions = {s.cabinet()};
+    s.config.semantic_fuel.object_pockets = false;
+    EXPECT_EQ(first(s), f);
+  }
+}
+
+TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
+  PocketScene s;
+  s.config.semantic_fuel.start_turns = 3;
+  SemanticFuelStrategy sem(s.config);
+  PlanContext ctx;
+  ctx.grid = &s.grid;
+  ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+  ctx.pose.yaw = 0.0;
+  ctx.regions = &s.regions;
+  ctx.frontiers = &s.frontiers;
+  ctx.rng = &s.rng;
+  ctx.counters = &s.counters;
+  double yaw = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    ctx.cycle = 2 * k + 1;
+    ctx.need_goal = true;
+    const Goal g = sem.plan(ctx).goal;
+    ASSERT_TRUE(g.valid);
+    EXPECT_EQ(g.position, ctx.pose.position) << "a turn in place";
+    EXPECT_NEAR(core::yaw_distance(g.yaw, yaw + 2.0 * core::kPi / 3.0), 0.0, 1e-9);
+    ctx.cycle = 2 * k + 2;
+    ctx.need_goal = false;  // not there yet: the same turn
+    EXPECT_EQ(sem.plan(ctx).goal.yaw, g.yaw);
+    yaw = g.yaw;
+    ctx.pose.yaw = yaw;
+  }
+  ctx.cycle = 7;
+  ctx.need_goal = true;
+  const Goal tour = sem.plan(ctx).goal;
+  ASSERT_TRUE(tour.valid);
+  EXPECT_GT((tour.position - ctx.pose.position).norm(), 0.3) << "then FUEL's tour";
+}
+
+TEST(SemanticFuel, DepFirstFliesDepsGoalUntilItsTimeThenFuelsTour) {
+  auto goal = [](Strategy& s, PocketScene& scene, int64_t utime) {
+    PlanContext ctx;
+    ctx.grid = &scene.grid;
+    ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+    ctx.pose.utime = utime;
+    ctx.regions = &scene.regions;
+    ctx.frontiers = &scene.frontiers;
+    ctx.cycle = 1;
+    ctx.rng = &scene.rng;
+    ctx.counters = &scene.counters;
+    ctx.min_gain = scene.config.gain.min_gain;
+    ctx.need_goal = true;
+    return s.plan(ctx).goal;
+  };
+  PocketScene a, b, c, d;
+  DepStrategy dep(a.config, false);
+  a.config.semantic_fuel.dep_first_s = 10.0;
+  b.config.semantic_fuel.dep_first_s = 10.0;
+  SemanticFuelStrategy first(b.config);
+  const Goal g = goal(dep, a, 0);
+  ASSERT_TRUE(g.valid);
+  EXPECT_EQ(goal(first, b, 0).position, g.position) << "DEP's goal before dep_first_s";
+  FuelStrategy fuel(c.config);
+  const Goal f = goal(fuel, c, 0);
+  ASSERT_GT((f.position - g.position).norm(), 0.1) << "the scene is meant to tell DEP's goal from FUEL's";
+  d.config.semantic_fuel.dep_first_s = 10.0;
+  SemanticFuelStrategy later(d.config);
+  goal(later, d, 0);
+  d.rng = core::SplitMixRng(1);
+  EXPECT_EQ(goal(later, d, 11000000).position, f.position) << "FUEL's tour after";
+}
+
+TEST(SemanticFuel, NearAnUnfinishedObjectIsWithinItsBoxAndMargin) {
+  SemanticRegion r;
+  r.class_id = static_cast<int>(runtime::SemanticClass::kTable);
+  r.centroid = Eigen::Vector3d(2.0, 2.0, 0.4);
+  r.extent = Eigen::Vector3d(1.2, 0.8, 0.8);
+  const std::vector<SemanticRegion> regions{r};
+  EXPECT_TRUE(near_unfinished_object({2.0, 2.0, 0.2}, regions, 0.5));   // under it
+  EXPECT_TRUE(near_unfinished_object({3.0, 2.0, 0.9}, regions, 0.5));   // by its edge
+  EXPECT_FALSE(near_unfinished_object({3.2, 2.0, 0.4}, regions, 0.5));  // beyond the margin
+  std::vector<SemanticRegion> other = regions;
+  other[0].extent = Eigen::Vector3d::Zero();  // no extent known
+  EXPECT_FALSE(near_unfinished_object({2.0, 2.0, 0.2}, other, 0.5));
+  other = regions;
+  other[0].class_id = static_cast<int>(runtime::SemanticClass::kDoor);
+  EXPECT_FALSE(near_unfinished_object({2.0, 2.0, 0.2}, other, 0.5));
+  other[0].class_id = static_cast<int>(runtime::SemanticClass::kWall);
+  EXPECT_FALSE(near_unfinished_object({2.0, 2.0, 0.2}, other, 0.5));
+}
+
+TEST(SemanticFuel, ALegBetweenRoomsCostsTheDoorCost) {
+  // Paths from the vehicle: the first passes no door, the second the door at x = 4, the third the
+  // door at x = 4 and then the one at x = 8 (its room is the last door's).
+  SemanticRegion d1, d2;
+  d1.class_id = d2.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
+  d1.centroid = Eigen::Vector3d(4.0, 2.0, 1.0);
+  d2.centroid = Eigen::Vector3d(8.0, 2.0, 1.0);
+  const std::vector<std::vector<Eigen::Vector3d>> paths = {
+      {{1, 2, 1}, {2, 2, 1}},
+      {{1, 2, 1}, {4.2, 2, 1}, {6, 2, 1}},
+      {{1, 2, 1}, {4.2, 2, 1}, {7.8, 2.3, 1}, {10, 2, 1}}};
+  const std::vector<int> room = door_rooms(paths, {d1, d2}, 1.0, 1.5);
+  EXPECT_EQ(room, (std::vector<int>{-1, 0, 1}));
+  TourProblem p;
+  p.n = 4;
+  p.cost.assign(16, 1.0);
+  add_room_change_cost(room, 10.0, p);
+  EXPECT_EQ(p.cost[0 * 4 + 1], 1.0);   // vehicle to its own room
+  EXPECT_EQ(p.cost[0 * 4 + 2], 11.0);  // vehicle to the room behind the first door
+  EXPECT_EQ(p.cost[2 * 4 + 3], 11.0);
+  EXPECT_EQ(p.cost[3 * 4 + 1], 11.0);
+  EXPECT_EQ(p.cost[1 * 4 + 0], 1.0);  // returns are free and stay so
+}
+
+TEST(SemanticFuel, ADoorwayFirstCostsTheFirstLegIntoOtherSitesOnlyWhileADoorwayIsLeft) {
+  TourProblem p;
+  p.n = 3;
+  p.cost.assign(9, 1.0);
+  add_doorway_first_cost({true, false}, 20.0, p);
+  EXPECT_EQ(p.cost[1], 1.0);   // into the doorway
+  EXPECT_EQ(p.cost[2], 21.0);  // into the other site first
+  EXPECT_EQ(p.cost[1 * 3 + 2], 1.0) << "legs after the first are FUEL's";
+  TourProblem q;
+  q.n = 3;
+  q.cost.assign(9, 1.0);
+  add_doorway_first_cost({false, false}, 20.0, q);
+  EXPECT_EQ(q.cost, std::vector<double>(9, 1.0)) << "no doorway: FUEL's tour";
+}
+
+}  // namespace
+}  // namespace semx::planner
