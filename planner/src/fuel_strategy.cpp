@@ -1,9 +1,9 @@
 #include "semx/planner/fuel_strategy.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 #include <limits>
 #include <sstream>
 
@@ -97,7 +97,8 @@ double FuelStrategy::first_leg(double distance, const Eigen::Vector3d& p, double
   // direction to the viewpoint, added to the flight's part (here the whole lower bound).
   const Eigen::Vector3d d = p - vehicle_;
   if (velocity_.norm() > 0.1 && d.norm() > 1e-6)
-    t += config_.fuel.direction_weight * std::acos(std::clamp(velocity_.normalized().dot(d.normalized()), -1.0, 1.0));
+    t += config_.fuel.direction_weight *
+         std::acos(std::clamp(velocity_.normalized().dot(d.normalized()), -1.0, 1.0));
   return t;
 }
 
@@ -115,7 +116,8 @@ bool FuelStrategy::eligible(const PlanContext& ctx, const VoxelKey& k) const {
 void FuelStrategy::update_clusters(PlanContext& ctx) {
   const map::StateGrid& grid = *ctx.grid;
   if (clusters_.resolution() != grid.resolution()) {
-    clusters_ = FrontierClusters(grid.resolution(), config_.fuel.min_cluster_voxels, config_.fuel.split_radius);
+    clusters_ =
+        FrontierClusters(grid.resolution(), config_.fuel.min_cluster_voxels, config_.fuel.split_radius);
     state_.clear();
     rebuild_ = true;
   }
@@ -149,7 +151,8 @@ void FuelStrategy::update_clusters(PlanContext& ctx) {
     const double phase = ctx.rng ? ctx.rng->uniform() : 0.0;
     s.views = sampler_.sample(grid, *clusters_.find(id), ctx.counters, phase);
     s.sampled_cycle = ctx.cycle;
-    ctx.counters->samples_drawn += static_cast<int64_t>(config_.fuel.view_radius_steps) * config_.fuel.view_angles;
+    ctx.counters->samples_drawn +=
+        static_cast<int64_t>(config_.fuel.view_radius_steps) * config_.fuel.view_angles;
     ctx.counters->nodes_added += static_cast<int64_t>(s.views.size());
   };
   for (int64_t id : changes.added) sample(id);
@@ -240,7 +243,8 @@ void FuelStrategy::compute_rows(PlanContext& ctx) {
     const Site& s = sites_[static_cast<size_t>(i)];
     return s.vehicle_distance[static_cast<size_t>(s.rep)];
   };
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return rep_distance(a) < rep_distance(b); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return rep_distance(a) < rep_distance(b); });
   int64_t used = 0;
   std::vector<Eigen::Vector3d> targets;
   for (int i : order) {
@@ -255,7 +259,8 @@ void FuelStrategy::compute_rows(PlanContext& ctx) {
     for (size_t j = 0; j < sites_.size(); ++j) {
       if (static_cast<int>(j) == i) continue;
       const Site& t = sites_[j];
-      targets.push_back(state_.at(t.cluster).views[static_cast<size_t>(t.views[static_cast<size_t>(t.rep)])].position);
+      targets.push_back(
+          state_.at(t.cluster).views[static_cast<size_t>(t.views[static_cast<size_t>(t.rep)])].position);
       ids.push_back(t.cluster);
     }
     core::Stopwatch w;
@@ -269,8 +274,9 @@ void FuelStrategy::compute_rows(PlanContext& ctx) {
   }
 }
 
-std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, int64_t keep, double* keep_cost,
-                                                             std::string* reason, int64_t* waiting) {
+std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, int64_t keep,
+                                                             double* keep_cost, std::string* reason,
+                                                             int64_t* waiting) {
   const FuelConfig& f = config_.fuel;
   const CostConfig& cost = config_.cost;
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
@@ -320,9 +326,10 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     // FUEL-size clusters first: the smaller ones only once none of those is left.
     auto major = [&](const Site& s) {
       const FrontierClusters::Cluster* c = clusters_.find(s.cluster);
-      return c && ((static_cast<int64_t>(c->voxels.size()) >= f.major_cluster_voxels &&
-                    state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage) ||
-                   promoted(ctx, *c));
+      return c &&
+             ((static_cast<int64_t>(c->voxels.size()) >= f.major_cluster_voxels &&
+               state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage) ||
+              promoted(ctx, *c));
     };
     if (std::any_of(sites_.begin(), sites_.end(), major))
       sites_.erase(std::remove_if(sites_.begin(), sites_.end(), [&](const Site& s) { return !major(s); }),
@@ -330,10 +337,10 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     if (waiting) *waiting = banned_only;
     if (sites_.empty()) {
       std::ostringstream r;
-      r << "no frontier cluster with a reachable viewpoint (" << clusters_.clusters().size() << " clusters of >= "
-        << f.min_cluster_voxels << " voxels, " << with_views << " with viewpoints, " << banned_only
-        << " of them only near goals skipped for now); " << (ctx.frontiers ? ctx.frontiers->size() : 0)
-        << " frontier voxels left";
+      r << "no frontier cluster with a reachable viewpoint (" << clusters_.clusters().size()
+        << " clusters of >= " << f.min_cluster_voxels << " voxels, " << with_views << " with viewpoints, "
+        << banned_only << " of them only near goals skipped for now); "
+        << (ctx.frontiers ? ctx.frontiers->size() : 0) << " frontier voxels left";
       *reason = r.str();
       return std::nullopt;
     }
@@ -439,7 +446,8 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     const Site& first = sites_[static_cast<size_t>(layer_site[0])];
     const int view_index = first.views[static_cast<size_t>(choices[0][static_cast<size_t>(pick)])];
     const Viewpoint goal_view = state_.at(first.cluster).views[static_cast<size_t>(view_index)];
-    const double goal_distance = first.vehicle_distance[static_cast<size_t>(choices[0][static_cast<size_t>(pick)])];
+    const double goal_distance =
+        first.vehicle_distance[static_cast<size_t>(choices[0][static_cast<size_t>(pick)])];
 
     // The path: A* over voxels along the coarse path, then anywhere.
     core::Stopwatch pw;
@@ -535,8 +543,8 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     why = "target covered";
   } else if (!checker_.node_free(target_.goal.position)) {
     why = "target viewpoint no longer free";
-  } else if (f.replan_period > 0 &&
-             ctx.pose.utime - target_.planned_utime >= static_cast<int64_t>(std::llround(f.replan_period * 1e6))) {
+  } else if (f.replan_period > 0 && ctx.pose.utime - target_.planned_utime >=
+                                        static_cast<int64_t>(std::llround(f.replan_period * 1e6))) {
     why = "periodic";
     periodic = true;
   }
@@ -553,7 +561,8 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   if (periodic) {
     target_.planned_utime = ctx.pose.utime;
     // Keep the target unless the new tour is clearly cheaper than the best one that keeps it.
-    const bool better = p && p->cluster != keep && (!(keep_cost < kInf) || p->tour_cost < (1.0 - f.switch_margin) * keep_cost);
+    const bool better = p && p->cluster != keep &&
+                        (!(keep_cost < kInf) || p->tour_cost < (1.0 - f.switch_margin) * keep_cost);
     if (!better) {
       replan_reason_ = "periodic: kept the target";
       out.goal = target_.goal;

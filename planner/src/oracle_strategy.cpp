@@ -68,17 +68,17 @@ struct OracleStrategy::Model {
   std::vector<float> factor;       // path cost per metre through the cell
   std::vector<uint32_t> allowed;   // bit k: moves()[k] from this cell keeps to passable cells
   std::vector<int64_t> move_offset;
-  std::vector<double> move_length;  // m
-  std::vector<float> move_cost;     // half the length: a move costs it times the two cells' factors
+  std::vector<double> move_length;         // m
+  std::vector<float> move_cost;            // half the length: a move costs it times the two cells' factors
   mutable std::vector<float> search_cost;  // scratch of search()
   mutable std::vector<uint8_t> search_want;
-  map::StateGrid grid;              // the truth as a map (outside the box unknown: an obstacle)
+  map::StateGrid grid;  // the truth as a map (outside the box unknown: an obstacle)
   CollisionChecker checker;
   double cap = 0.6;  // clearances are exact up to this
 
   // The camera: rays from a cell's centre, each a run of steps.
   struct Step {
-    int32_t offset;  // cell index difference from the ray's origin
+    int32_t offset;       // cell index difference from the ray's origin
     uint32_t free_mask;   // yaw bins that observe the cell when the ray passes through it
     uint32_t hit_mask;    // ... when the ray's return ends in it
     uint32_t valid_mask;  // ... for which a return in it is not nearer than min_range
@@ -108,7 +108,9 @@ struct OracleStrategy::Model {
     if (x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz) return -1;
     return x + y * sy + z * sz;
   }
-  int64_t index_of(const Eigen::Vector3d& p) const { return p.allFinite() ? index_of(grid.keys().key(p)) : -1; }
+  int64_t index_of(const Eigen::Vector3d& p) const {
+    return p.allFinite() ? index_of(grid.keys().key(p)) : -1;
+  }
   Eigen::Vector3d centre(int64_t i) const { return grid.keys().center(key_of(i)); }
 
   void build_rays(const GainConfig& g, const OracleConfig& o);
@@ -404,7 +406,8 @@ int64_t OracleStrategy::Model::entry(const Eigen::Vector3d& p) const {
   return best;
 }
 
-bool OracleStrategy::Model::segment_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double need) const {
+bool OracleStrategy::Model::segment_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                       double need) const {
   const double len = (b - a).norm();
   const int k = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
   for (int s = 0; s <= k; ++s) {
@@ -426,12 +429,12 @@ std::string OracleSummary::describe() const {
   }
   s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
     << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
-    << first_pass << " in the first pass, e " << first_pass_exponent << (first_pass_toured ? " toured" : " walked")
-    << (first_pass_improved ? ", reordered" : "") << ", modelled " << first_pass_early_time << " / "
-    << first_pass_target_time << " s to the early / target share";
+    << first_pass << " in the first pass, e " << first_pass_exponent
+    << (first_pass_toured ? " toured" : " walked") << (first_pass_improved ? ", reordered" : "")
+    << ", modelled " << first_pass_early_time << " / " << first_pass_target_time
+    << " s to the early / target share";
   if (first_pass_improved) s << " (sum " << first_pass_before_improvement << " s before reordering)";
-  s << ") see " << 100.0 * cover_share() << " % of that (" << cover_dropped
-    << " redundant dropped); tour "
+  s << ") see " << 100.0 * cover_share() << " % of that (" << cover_dropped << " redundant dropped); tour "
     << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
     << "; prepared in " << prepare_ms / 1000.0 << " s";
   return s.str();
@@ -512,7 +515,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     int8_t& v = ok[static_cast<size_t>(i)];
     if (v < 0) {
       const Eigen::Vector3d c = m.centre(i);
-      v = (m.flags[static_cast<size_t>(i)] & kPassable) && m.start_length[static_cast<size_t>(i)] < kUnreached &&
+      v = (m.flags[static_cast<size_t>(i)] & kPassable) &&
+          m.start_length[static_cast<size_t>(i)] < kUnreached &&
           m.clear[static_cast<size_t>(i)] >= config_.collision.clearance && c.z() >= config_.sampling.z_min &&
           c.z() <= config_.sampling.z_max && m.checker.node_free(c);
     }
@@ -579,8 +583,10 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   for (size_t g = 0; g < groups; ++g) {
     source.elements(static_cast<int>(g), els);
     for (const MaskedElement& e : els) {
-      if (!m.observable[static_cast<size_t>(e.element)]) m.observable[static_cast<size_t>(e.element)] = 1, ++observable;
-      for (uint32_t x = e.members; x; x &= x - 1) ++bound[g * static_cast<size_t>(bins) + static_cast<size_t>(__builtin_ctz(x))];
+      if (!m.observable[static_cast<size_t>(e.element)])
+        m.observable[static_cast<size_t>(e.element)] = 1, ++observable;
+      for (uint32_t x = e.members; x; x &= x - 1)
+        ++bound[g * static_cast<size_t>(bins) + static_cast<size_t>(__builtin_ctz(x))];
     }
   }
   auto yaw_of = [&](int b) { return b * 2.0 * M_PI / bins; };
@@ -633,23 +639,25 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     bool improved = false;  // reordered by the model's times (3b)
     double before = 0.0;    // s, its score before that
   };
-  const auto want = static_cast<int64_t>(std::ceil(
-      std::min(static_cast<double>(observable),
-               std::max(oc.first_pass * static_cast<double>(observable),
-                        oc.target_share * static_cast<double>(m.targets.size())))));
-  const auto target = static_cast<int64_t>(std::ceil(oc.target_share * static_cast<double>(m.targets.size())));
-  const auto early =
-      static_cast<int64_t>(std::ceil(std::min(oc.early_share, oc.target_share) * static_cast<double>(m.targets.size())));
+  const auto want = static_cast<int64_t>(std::ceil(std::min(
+      static_cast<double>(observable), std::max(oc.first_pass * static_cast<double>(observable),
+                                                oc.target_share * static_cast<double>(m.targets.size())))));
+  const auto target =
+      static_cast<int64_t>(std::ceil(oc.target_share * static_cast<double>(m.targets.size())));
+  const auto early = static_cast<int64_t>(
+      std::ceil(std::min(oc.early_share, oc.target_share) * static_cast<double>(m.targets.size())));
   // The candidate nearest a cell (within the lattice's pitch), -1 when none: what the camera sees
   // on the way is modelled by what the candidates it passes see.
   std::unordered_map<int64_t, std::vector<int>> lattice;
   const double pitch = std::max(oc.spacing, oc.height_step);
   auto coarse = [&](const Eigen::Vector3d& p) {
-    const int64_t x = static_cast<int64_t>(std::floor(p.x() / pitch)), y = static_cast<int64_t>(std::floor(p.y() / pitch)),
+    const int64_t x = static_cast<int64_t>(std::floor(p.x() / pitch)),
+                  y = static_cast<int64_t>(std::floor(p.y() / pitch)),
                   z = static_cast<int64_t>(std::floor(p.z() / pitch));
     return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
   };
-  for (size_t g = 0; g < groups; ++g) lattice[coarse(m.centre(m.candidates[g]))].push_back(static_cast<int>(g));
+  for (size_t g = 0; g < groups; ++g)
+    lattice[coarse(m.centre(m.candidates[g]))].push_back(static_cast<int>(g));
   auto nearest_candidate = [&](int64_t cell) {
     const Eigen::Vector3d p = m.centre(cell);
     int best_g = -1;
@@ -681,7 +689,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     auto show = [&](int g, int b, double t) {
       source.elements(g, els);
       for (const MaskedElement& e : els)
-        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++have;
+        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)])
+          seen[static_cast<size_t>(e.element)] = 1, ++have;
       if (have >= early && !(sc.early_time < std::numeric_limits<double>::infinity())) sc.early_time = t;
       if (have >= target) sc.target_time = t;
       return have >= target;
@@ -692,7 +701,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       if (q < sc.legs.size() && sc.legs[q].size() > 2) {
         const std::vector<int64_t>& cells = sc.legs[q];
         std::vector<double> arc{0.0};
-        for (size_t i = 1; i < cells.size(); ++i) arc.push_back(arc.back() + (m.centre(cells[i]) - m.centre(cells[i - 1])).norm());
+        for (size_t i = 1; i < cells.size(); ++i)
+          arc.push_back(arc.back() + (m.centre(cells[i]) - m.centre(cells[i - 1])).norm());
         const double total = arc.back();
         const double turn = core::wrap_angle(yaw1 - yaw0);
         double next = 0.5;
@@ -763,7 +773,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           if (!sc.shown[static_cast<size_t>(e.element)])
             for (uint32_t x = e.members; x; x &= x - 1) ++gains[static_cast<size_t>(__builtin_ctz(x))];
         for (int k = 0; k < bins; ++k) {
-          bound[static_cast<size_t>(g) * static_cast<size_t>(bins) + static_cast<size_t>(k)] = gains[static_cast<size_t>(k)];
+          bound[static_cast<size_t>(g) * static_cast<size_t>(bins) + static_cast<size_t>(k)] =
+              gains[static_cast<size_t>(k)];
           const double t = gains[static_cast<size_t>(k)] > 0 ? time_to(static_cast<size_t>(g), k) : -1.0;
           if (t > 0) heap.emplace(static_cast<double>(gains[static_cast<size_t>(k)]) / t, g, k, true);
         }
@@ -817,7 +828,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       if (cells[a] != cells[b]) {
         m.search(cells[a], cells[b], len, &parent);
         sc.legs.push_back(parent[static_cast<size_t>(cells[b])] >= 0 ? cell_path(cells[a], cells[b], parent)
-                                                                      : std::vector<int64_t>{});
+                                                                     : std::vector<int64_t>{});
       } else {
         sc.legs.emplace_back();
       }
@@ -872,7 +883,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           leg_cells[ab] = cell_path(cells[a], cells[b], parent);
           const std::vector<int64_t>& pc = leg_cells[ab];
           std::vector<double> arc{0.0};
-          for (size_t i = 1; i < pc.size(); ++i) arc.push_back(arc.back() + (m.centre(pc[i]) - m.centre(pc[i - 1])).norm());
+          for (size_t i = 1; i < pc.size(); ++i)
+            arc.push_back(arc.back() + (m.centre(pc[i]) - m.centre(pc[i - 1])).norm());
           const double total = arc.back(), turn = core::wrap_angle(yaws[b] - yaws[a]);
           double next = 0.5;
           for (size_t i = 1; i + 1 < pc.size() && total > 0; ++i) {
@@ -913,7 +925,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           const double t = clock + q.f * (t1 - clock);
           if (show(q.g, q.bin, t)) return early_at + t;
         }
-        if (show(nodes[static_cast<size_t>(v) - 1].first, vbin[static_cast<size_t>(v)], t1)) return early_at + t1;
+        if (show(nodes[static_cast<size_t>(v) - 1].first, vbin[static_cast<size_t>(v)], t1))
+          return early_at + t1;
         clock = t1;
         prev = static_cast<size_t>(v);
       }
@@ -975,7 +988,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
 
   // 4. The cover of the rest: greedy picks until cover_fraction of the observable part is shown,
   // what the first pass showed counting.
-  const CoverResult cover = greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction, &shown);
+  const CoverResult cover =
+      greedy_cover(source, static_cast<int32_t>(m.targets.size()), oc.cover_fraction, &shown);
   summary_.observable = cover.observable;
   summary_.covered = cover.covered;
   summary_.first_pass = static_cast<int64_t>(walk.size());
@@ -1030,7 +1044,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       source.elements(g, els);
       int64_t gain = 0;
       for (const MaskedElement& e : els)
-        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)]) seen[static_cast<size_t>(e.element)] = 1, ++gain;
+        if ((e.members >> b & 1u) && !seen[static_cast<size_t>(e.element)])
+          seen[static_cast<size_t>(e.element)] = 1, ++gain;
       add(g, b, gain);
     }
   }
@@ -1046,7 +1061,8 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   return true;
 }
 
-std::vector<Eigen::Vector3d> OracleStrategy::truth_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+std::vector<Eigen::Vector3d> OracleStrategy::truth_path(const Eigen::Vector3d& from,
+                                                        const Eigen::Vector3d& to) const {
   if (!model_) return {};
   const Model& m = *model_;
   const int64_t s = m.entry(from), g = m.index_of(to);
@@ -1129,7 +1145,8 @@ void OracleStrategy::hold_square(std::vector<Eigen::Vector3d>& path, std::vector
     held.push_back(tight(b) ? 1 : 0);
     const double q = M_PI / 2;
     for (size_t j = first - 1; j < out.size(); ++j)
-      if (held[j]) out_yaw[j] = core::wrap_angle(travel + q * std::round(core::wrap_angle(out_yaw[j] - travel) / q));
+      if (held[j])
+        out_yaw[j] = core::wrap_angle(travel + q * std::round(core::wrap_angle(out_yaw[j] - travel) / q));
   }
   // The vehicle's heading is what it is; the goal keeps the yaw it was chosen for.
   out_yaw.front() = yaws.front();
@@ -1173,7 +1190,9 @@ std::vector<MaskedElement> OracleStrategy::candidate_view(size_t candidate) cons
   return out;
 }
 
-int64_t OracleStrategy::target_ids() const { return model_ ? static_cast<int64_t>(model_->targets.size()) : 0; }
+int64_t OracleStrategy::target_ids() const {
+  return model_ ? static_cast<int64_t>(model_->targets.size()) : 0;
+}
 
 PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
   PlanOutcome o;
@@ -1244,7 +1263,8 @@ PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
       length += len;
       end = i;
       ++chained;
-      const bool keeps_up = core::yaw_distance(from_yaw, v.yaw) / config_.cost.yaw_rate <= len / config_.cost.velocity;
+      const bool keeps_up =
+          core::yaw_distance(from_yaw, v.yaw) / config_.cost.yaw_rate <= len / config_.cost.velocity;
       from = v.position;
       from_yaw = v.yaw;
       if (!keeps_up) break;

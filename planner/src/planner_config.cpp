@@ -60,8 +60,8 @@ void get_vec3(runtime::ConfigMap& m, const std::string& key, Eigen::Vector3d& ou
 }  // namespace
 
 void load(runtime::ConfigMap& m, PlannerConfig& c) {
-  m.get_choice("planner", c.planner, {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room",
-                                      "semantic-fuel"});
+  m.get_choice("planner", c.planner,
+               {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room", "semantic-fuel"});
   m.get("seed", c.seed);
   m.get("rate_hz", c.rate_hz, 0.01, 1000.0);
 

@@ -166,7 +166,6 @@ Tour solve_open_tour(const TourProblem& p, int exact_max, int first) {
   return heuristic_open_tour(p, first);
 }
 
-
 Tour solve_tour(const std::vector<std::vector<double>>& cost, int exact_max) {
   TourProblem p;
   p.n = static_cast<int>(cost.size());
@@ -185,7 +184,8 @@ double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector
   return c;
 }
 
-std::vector<int> improve_order(std::vector<int> order, const std::function<double(const std::vector<int>&)>& objective,
+std::vector<int> improve_order(std::vector<int> order,
+                               const std::function<double(const std::vector<int>&)>& objective,
                                int max_evaluations, bool may_drop) {
   int evaluations = 1;
   double best = objective(order);
@@ -217,7 +217,8 @@ std::vector<int> improve_order(std::vector<int> order, const std::function<doubl
         std::vector<int> seg(order.begin() + static_cast<std::ptrdiff_t>(i),
                              order.begin() + static_cast<std::ptrdiff_t>(i + len));
         std::vector<int> rest = order;
-        rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i), rest.begin() + static_cast<std::ptrdiff_t>(i + len));
+        rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(i),
+                   rest.begin() + static_cast<std::ptrdiff_t>(i + len));
         for (size_t j = 0; j <= rest.size() && !improved; ++j) {
           if (j == i) continue;
           std::vector<int> c = rest;

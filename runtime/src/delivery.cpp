@@ -8,8 +8,8 @@ void Inbox::reads(uint32_t tag) {
   if (tags_.insert(tag).second && ticked_) fresh_tags_.insert(tag);
 }
 
-Inbox::Arrival Inbox::arrive(const StreamKey& s, uint32_t seq, const std::string& channel, const uint8_t* bytes,
-                             std::size_t size, double now) {
+Inbox::Arrival Inbox::arrive(const StreamKey& s, uint32_t seq, const std::string& channel,
+                             const uint8_t* bytes, std::size_t size, double now) {
   if (s.sender == self_) return Arrival::kDeliver;  // its own messages, looped back
   Stream& st = streams_[s];
   if (st.next == 0) {

@@ -192,7 +192,9 @@ DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data
     return DatagramError::kFragment;  // the same original fragment twice
   }
   if (n) std::memcpy(p.data.data() + offset, data + at, n);
-  if (number == 0) p.channel.assign(reinterpret_cast<const char*>(data + kLcmLongHeader), static_cast<std::size_t>(name_len));
+  if (number == 0)
+    p.channel.assign(reinterpret_cast<const char*>(data + kLcmLongHeader),
+                     static_cast<std::size_t>(name_len));
   p.seen[number] = true;
   p.resent = p.resent || resend;
   if (--p.remaining > 0) {
@@ -202,7 +204,9 @@ DatagramError LcmReassembler::feed_fragment(uint64_t sender, const uint8_t* data
     if (tail_bytes_ > 0 && !p.tail_told && number + 1u == count && msg_size - offset >= tail_bytes_ &&
         msg_size >= tail_bytes_ && tails_.size() < kMaxTails) {
       p.tail_told = true;
-      tails_.push_back({sender, seqno, std::vector<uint8_t>(p.data.end() - static_cast<std::ptrdiff_t>(tail_bytes_), p.data.end())});
+      tails_.push_back(
+          {sender, seqno,
+           std::vector<uint8_t>(p.data.end() - static_cast<std::ptrdiff_t>(tail_bytes_), p.data.end())});
     }
     return DatagramError::kNone;
   }

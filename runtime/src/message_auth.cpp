@@ -49,7 +49,8 @@ std::array<uint8_t, 32> hmac(const std::array<uint8_t, 32>& key, const std::stri
   put64(msg + n, value);
   std::array<uint8_t, 32> out{};
   unsigned int len = 0;
-  if (!HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), msg, n + 8, out.data(), &len) || len != 32)
+  if (!HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), msg, n + 8, out.data(), &len) ||
+      len != 32)
     throw std::runtime_error("HMAC-SHA256 failed");
   return out;
 }
@@ -108,7 +109,8 @@ AuthKey AuthKey::open() { return AuthKey(std::array<uint8_t, 32>{}, true); }
 
 AuthKey AuthKey::random() {
   std::array<uint8_t, 32> k{};
-  if (RAND_bytes(k.data(), static_cast<int>(k.size())) != 1) throw std::runtime_error("no random bytes for a key");
+  if (RAND_bytes(k.data(), static_cast<int>(k.size())) != 1)
+    throw std::runtime_error("no random bytes for a key");
   return AuthKey(k, false);
 }
 
@@ -176,7 +178,9 @@ void AuthKey::write_file(const std::string& path) const {
   if (!ok) throw std::runtime_error(path + ": cannot write the key file");
 }
 
-std::array<uint8_t, 32> AuthKey::sender_key(uint64_t sender) const { return hmac(key_, "semx sender", sender); }
+std::array<uint8_t, 32> AuthKey::sender_key(uint64_t sender) const {
+  return hmac(key_, "semx sender", sender);
+}
 
 // ---- trailers ----
 
@@ -216,7 +220,8 @@ const char* to_string(AuthVerdict v) {
 
 // ---- MessageSigner ----
 
-MessageSigner::MessageSigner(const AuthKey& key) : cipher_(std::make_unique<Cipher>()), session_(key.session()) {
+MessageSigner::MessageSigner(const AuthKey& key)
+    : cipher_(std::make_unique<Cipher>()), session_(key.session()) {
   uint8_t id[8];
   if (RAND_bytes(id, sizeof id) != 1) throw std::runtime_error("no random bytes for a sender id");
   sender_ = get64(id);

@@ -192,23 +192,24 @@ void Node::update_receiver() {
       if (const char* rate = std::getenv("SEMX_TEST_DROP_RATE"); rate && *rate) {
         // A lossy bus for tests and experiments: this node loses that share of its datagrams.
         const char* seed = std::getenv("SEMX_TEST_DROP_SEED");
-        receiver_->drop_for_test(std::atof(rate),
-                                 std::hash<std::string>{}(options_.name) ^ (seed ? std::strtoull(seed, nullptr, 10) : 0));
+        receiver_->drop_for_test(std::atof(rate), std::hash<std::string>{}(options_.name) ^
+                                                      (seed ? std::strtoull(seed, nullptr, 10) : 0));
       }
       if (const char* ms = std::getenv("SEMX_TEST_JITTER_MS"); ms && *ms) {
         // A bus with jitter: this node's datagrams each come up to that late, out of order.
         const char* seed = std::getenv("SEMX_TEST_DROP_SEED");
         receiver_->delay_for_test(std::atof(ms) / 1000.0, std::hash<std::string>{}(options_.name) ^
-                                                              (seed ? std::strtoull(seed, nullptr, 10) : 0) ^ 0x6a09e667u);
+                                                              (seed ? std::strtoull(seed, nullptr, 10) : 0) ^
+                                                              0x6a09e667u);
       }
       if (receiver_->granted_recv_buf() < receiver_->requested_recv_buf()) {
-        throw NodeError("the LCM URL asks for a " + std::to_string(receiver_->requested_recv_buf()) +
-                        "-byte receive buffer and the kernel grants " +
-                        std::to_string(receiver_->granted_recv_buf()) +
-                        " (net.core.rmem_max): bursts of camera frames would be lost. Raise it (as root: sysctl "
-                        "-w net.core.rmem_max=" +
-                        std::to_string(receiver_->requested_recv_buf()) +
-                        "), or ask for less with recv_buf_size= in the URL");
+        throw NodeError(
+            "the LCM URL asks for a " + std::to_string(receiver_->requested_recv_buf()) +
+            "-byte receive buffer and the kernel grants " + std::to_string(receiver_->granted_recv_buf()) +
+            " (net.core.rmem_max): bursts of camera frames would be lost. Raise it (as root: sysctl "
+            "-w net.core.rmem_max=" +
+            std::to_string(receiver_->requested_recv_buf()) +
+            "), or ask for less with recv_buf_size= in the URL");
       }
     }
     std::vector<std::string> refused;
@@ -337,7 +338,8 @@ bool Node::may_deliver(const StreamKey& stream, uint32_t seq) const {
   return named(tick_heads_, stream, seq);
 }
 
-bool Node::in_time(const StreamKey& stream, const uint8_t* payload, std::size_t size, int64_t tick_utime) const {
+bool Node::in_time(const StreamKey& stream, const uint8_t* payload, std::size_t size,
+                   int64_t tick_utime) const {
   if (size < 16) return true;
   uint64_t u = 0;  // big-endian int64 right after the 8-byte fingerprint: every semx type's utime
   for (int i = 8; i < 16; ++i) u = (u << 8) | payload[i];
@@ -345,8 +347,8 @@ bool Node::in_time(const StreamKey& stream, const uint8_t* payload, std::size_t 
   return stream.sender == clock_sender_ ? utime <= tick_utime : utime < tick_utime;
 }
 
-void Node::deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
-                           uint32_t seq) {
+void Node::deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size,
+                           const StreamKey& stream, uint32_t seq) {
   bool now = may_deliver(stream, seq);
   for (auto it = deferred_.begin(); now && it != deferred_.end(); ++it) {
     if (!(it->stream < stream) && !(stream < it->stream)) now = false;  // after its stream's waiting ones
@@ -415,7 +417,8 @@ void Node::on_resend_request(const semx::resend_t& r) {
     } else {
       resend_buffer_.assign(kept->begin(), kept->end() - static_cast<std::ptrdiff_t>(kAuthTrailerBytes));
       signer_.sign_as(*channel, resend_buffer_, seq);
-      sent = lcm_->publish(*channel, resend_buffer_.data(), static_cast<unsigned int>(resend_buffer_.size())) == 0;
+      sent = lcm_->publish(*channel, resend_buffer_.data(),
+                           static_cast<unsigned int>(resend_buffer_.size())) == 0;
     }
     if (sent) ++counters_.resent;
   }
@@ -424,7 +427,8 @@ void Node::on_resend_request(const semx::resend_t& r) {
 std::vector<std::pair<int32_t, int32_t>> Node::own_heads() const {
   std::vector<std::pair<int32_t, int32_t>> out;
   for (const auto& [channel, seq] : signer_.heads()) {
-    if (tracked(channel)) out.emplace_back(static_cast<int32_t>(channel_tag(channel)), static_cast<int32_t>(seq));
+    if (tracked(channel))
+      out.emplace_back(static_cast<int32_t>(channel_tag(channel)), static_cast<int32_t>(seq));
   }
   return out;
 }
@@ -512,7 +516,8 @@ void Node::service_delivery() {
     const HeldTick tick = held_ticks_.front();
     handle_tick_in_turn(tick.msg, tick.heads, true);
   }
-  if (held_ticks_.empty() && !deferred_.empty() && last_clock_wall_ >= 0 && now - last_clock_wall_ >= kClockGoneS)
+  if (held_ticks_.empty() && !deferred_.empty() && last_clock_wall_ >= 0 &&
+      now - last_clock_wall_ >= kClockGoneS)
     release_deferred(nullptr, std::nullopt, true);
 }
 
@@ -722,9 +727,9 @@ void Node::handle_tick(const semx::clock_t& msg, bool may_ack) {
   const bool skip_ack = decision.new_tick && !decision.reset && quiet_until_ > msg.utime &&
                         last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
                         msg.utime - last_ack_utime_ < kAckIntervalUs;
-  const bool heads_ack = !decision.ack && may_ack && msg.mode == semx::clock_t::REALTIME && !options_.observer &&
-                         options_.sign && wall_s() - last_heads_ack_wall_ >= kRealtimeHeadsPeriodS &&
-                         !own_heads().empty();
+  const bool heads_ack = !decision.ack && may_ack && msg.mode == semx::clock_t::REALTIME &&
+                         !options_.observer && options_.sign &&
+                         wall_s() - last_heads_ack_wall_ >= kRealtimeHeadsPeriodS && !own_heads().empty();
   if ((decision.ack && may_ack && !skip_ack) || heads_ack) {
     if (heads_ack) last_heads_ack_wall_ = wall_s();
     semx::ack_t ack{};
@@ -847,7 +852,8 @@ int Node::receive_once(int wait_ms) {
     // An incomplete message's trailer (unverified: it is only a hint) names its stream and seq,
     // so the node asks for it now instead of when a later message of the channel comes whole.
     const auto t = read_trailer(tail.bytes.data(), tail.bytes.size());
-    if (!t || t->session != verifier_.session() || !verifier_.knows(t->sender) || !seqno_tagged(tail.seqno)) continue;
+    if (!t || t->session != verifier_.session() || !verifier_.knows(t->sender) || !seqno_tagged(tail.seqno))
+      continue;
     inbox_.hint({t->sender, (tail.seqno >> kSeqnoTagShift) & kSeqnoTagBits}, t->seq);
   }
   if (!got) return 0;

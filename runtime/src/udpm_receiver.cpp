@@ -283,7 +283,8 @@ bool UdpmReceiver::next_delayed(LcmMessageView* out) {
   uint64_t sender = 0;
   while (read_datagram(&n, &sender)) {
     const double u = static_cast<double>(xorshift(delay_state_) >> 11) * 0x1.0p-53;
-    delayed_.push({now + u * delay_max_s_, delay_order_++, sender, std::vector<uint8_t>(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(n))});
+    delayed_.push({now + u * delay_max_s_, delay_order_++, sender,
+                   std::vector<uint8_t>(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(n))});
   }
   while (!delayed_.empty() && delayed_.top().due <= now) {
     // priority_queue's top is const: the bytes are moved out through a cast, then popped.

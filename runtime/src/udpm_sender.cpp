@@ -74,7 +74,8 @@ UdpmSender::~UdpmSender() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t* seqno_out) {
+bool UdpmSender::publish(const std::string& channel, const uint8_t* data, std::size_t size,
+                         uint32_t* seqno_out) {
   if (channel.empty() || channel.size() > kLcmMaxChannel || channel.find('\0') != std::string::npos)
     return false;
   const uint32_t seqno = kSeqnoTagged | (channel_tag(channel) << kSeqnoTagShift) | counter_++;
@@ -90,8 +91,8 @@ bool UdpmSender::publish_again(const std::string& channel, const uint8_t* data, 
   return send_message(channel, data, size, seqno, kSemxMagicResend);
 }
 
-bool UdpmSender::send_message(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t seqno,
-                              uint32_t fragment_magic) {
+bool UdpmSender::send_message(const std::string& channel, const uint8_t* data, std::size_t size,
+                              uint32_t seqno, uint32_t fragment_magic) {
   sockaddr_in to{};
   to.sin_family = AF_INET;
   to.sin_addr.s_addr = group_;

@@ -179,9 +179,11 @@ TEST(Streaming, MirrorRefusesDeltasAfterAGapUntilASnapshot) {
   // Updates the mirror holds already: the snapshot of map 6 came before updates 5 and 6 (two
   // channels, not ordered against each other on a lossy bus). Not a gap; update 7 follows.
   map::StateGrid at6(0.1);
-  for (const auto& [k, st] : std::vector<std::pair<map::VoxelKey, map::VoxelState>>{
-           {{0, 0, 0}, map::VoxelState::kFree}, {{1, 0, 0}, map::VoxelState::kFree},
-           {{2, 0, 0}, map::VoxelState::kOccupied}, {{3, 0, 0}, map::VoxelState::kFree}})
+  for (const auto& [k, st] :
+       std::vector<std::pair<map::VoxelKey, map::VoxelState>>{{{0, 0, 0}, map::VoxelState::kFree},
+                                                              {{1, 0, 0}, map::VoxelState::kFree},
+                                                              {{2, 0, 0}, map::VoxelState::kOccupied},
+                                                              {{3, 0, 0}, map::VoxelState::kFree}})
     at6.set_state(k, st);
   at6.set_state({4, 0, 0}, map::VoxelState::kOccupied);
   at6.set_state({5, 0, 0}, map::VoxelState::kOccupied);

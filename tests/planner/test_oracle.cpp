@@ -71,7 +71,8 @@ int brute_force_cover(const std::vector<std::bitset<N>>& sets, size_t required, 
   return -1;
 }
 
-size_t covered_by(const std::vector<std::vector<std::vector<int32_t>>>& sets, const std::vector<CoverPick>& picks) {
+size_t covered_by(const std::vector<std::vector<std::vector<int32_t>>>& sets,
+                  const std::vector<CoverPick>& picks) {
   std::vector<int32_t> all;
   for (const CoverPick& p : picks)
     for (int32_t e : sets[static_cast<size_t>(p.group)][static_cast<size_t>(p.member)]) all.push_back(e);
@@ -106,7 +107,8 @@ TEST(OracleCover, TheLazyGreedyPicksWhatThePlainGreedyPicksAndNeverMoreThanItsBo
     std::bitset<64> all;
     for (const auto& b : flat) all |= b;
     EXPECT_EQ(r.observable, static_cast<int64_t>(all.count()));
-    EXPECT_EQ(r.required, static_cast<int64_t>(std::ceil(fraction * static_cast<double>(all.count()) - 1e-9)));
+    EXPECT_EQ(r.required,
+              static_cast<int64_t>(std::ceil(fraction * static_cast<double>(all.count()) - 1e-9)));
     // What it claims is what the picks hold, and it is enough.
     EXPECT_EQ(static_cast<int64_t>(covered_by(sets, r.picks)), r.covered);
     EXPECT_GE(r.covered, r.required);
@@ -116,7 +118,8 @@ TEST(OracleCover, TheLazyGreedyPicksWhatThePlainGreedyPicksAndNeverMoreThanItsBo
     for (const CoverPick& p : r.picks)
       EXPECT_NE(std::find(eager.begin(), eager.end(), std::make_pair(p.group, p.member)), eager.end());
     // Against the optimum: the greedy's ln(n) + 1 bound (for a full cover), and often equal.
-    const int best = brute_force_cover(flat, static_cast<size_t>(r.required), static_cast<int>(r.picks.size()));
+    const int best =
+        brute_force_cover(flat, static_cast<size_t>(r.required), static_cast<int>(r.picks.size()));
     ASSERT_GT(best, 0);
     EXPECT_LE(static_cast<double>(r.picks.size()), best * (std::log(40.0) + 1.0));
     optimal += static_cast<int>(r.picks.size()) == best;
@@ -299,7 +302,7 @@ SyntheticWorld tiny_world() {
 
 PlannerConfig tiny_config() {
   PlannerConfig c = test_config("oracle");
-  c.oracle.spacing = 1.2;  // 9 candidates at 4 yaws: a brute force of a second
+  c.oracle.spacing = 1.2;      // 9 candidates at 4 yaws: a brute force of a second
   c.oracle.height_step = 1.0;  // one level of candidates
   c.sampling.z_min = 1.0;
   c.sampling.z_max = 1.4;
@@ -355,7 +358,8 @@ TEST(Oracle, OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
   ASSERT_GT(best, 0);
   EXPECT_EQ(static_cast<int>(oracle.picks().size()), best);
   std::bitset<32768> mine;
-  for (const CoverPick& p : oracle.picks()) mine |= sets[static_cast<size_t>(p.group * c.gain.yaw_bins + p.member)];
+  for (const CoverPick& p : oracle.picks())
+    mine |= sets[static_cast<size_t>(p.group * c.gain.yaw_bins + p.member)];
   EXPECT_EQ(static_cast<int64_t>(mine.count()), s.covered);
 
   // The tour: the best order of its viewpoints by brute force, and the viewpoints flown in it.

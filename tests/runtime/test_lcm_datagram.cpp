@@ -149,7 +149,8 @@ TEST(LcmDatagram, AResendFillsTheHolesOfTheFirstCopy) {
   const uint32_t seq = kSeqnoTagged | (5u << kSeqnoTagShift) | 200;
   std::vector<std::vector<uint8_t>> frags;
   for (uint16_t k = 0; k < 3; ++k)
-    frags.push_back(fragment(seq, 3000, k * 1000u, k, 3, "ESDF_LOCAL", {p.begin() + k * 1000, p.begin() + (k + 1) * 1000}));
+    frags.push_back(fragment(seq, 3000, k * 1000u, k, 3, "ESDF_LOCAL",
+                             {p.begin() + k * 1000, p.begin() + (k + 1) * 1000}));
   EXPECT_EQ(f(9, frags[0], 1.0), DatagramError::kNone);
   EXPECT_EQ(f(9, frags[2], 1.0), DatagramError::kNone);
   EXPECT_FALSE(f.complete);
@@ -168,8 +169,10 @@ TEST(LcmDatagram, AResendFillsTheHolesOfTheFirstCopy) {
   // A resend of a message whose first copy never came makes it on its own.
   const uint32_t seq2 = seq + 1;
   for (uint16_t k = 0; k < 3; ++k) {
-    EXPECT_EQ(f(9, resent(fragment(seq2, 3000, k * 1000u, k, 3, "ESDF_LOCAL",
-                                   {p.begin() + k * 1000, p.begin() + (k + 1) * 1000})), 1.1),
+    EXPECT_EQ(f(9,
+                resent(fragment(seq2, 3000, k * 1000u, k, 3, "ESDF_LOCAL",
+                                {p.begin() + k * 1000, p.begin() + (k + 1) * 1000})),
+                1.1),
               DatagramError::kNone);
   }
   ASSERT_TRUE(f.complete);

@@ -68,7 +68,8 @@ TEST(LossyBus, EveryMessageArrivesInOrderDespiteTenPercentLoss) {
   {
     DropRate loss("0.1");
     sub_ptr = std::make_unique<Node>(options("sub", 0));
-    sub_ptr->subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t& m) { odometry.push_back(m.utime); });
+    sub_ptr->subscribe<semx::odometry_t>("ODOMETRY",
+                                         [&](const semx::odometry_t& m) { odometry.push_back(m.utime); });
     sub_ptr->subscribe<semx::depth_image_t>("CAMERA_DEPTH",
                                             [&](const semx::depth_image_t& m) { frames.push_back(m.utime); });
   }
@@ -142,7 +143,8 @@ TEST(LossyBus, ALockstepReaderAcksATickOnlyOnceItHoldsWhatItsHeadsName) {
   }
   // Tick k was handled with frames 0..k held, whatever was lost on the way.
   ASSERT_EQ(frames_at_tick.size(), 20u);
-  for (std::size_t k = 0; k < frames_at_tick.size(); ++k) EXPECT_EQ(frames_at_tick[k], static_cast<int64_t>(k + 1)) << k;
+  for (std::size_t k = 0; k < frames_at_tick.size(); ++k)
+    EXPECT_EQ(frames_at_tick[k], static_cast<int64_t>(k + 1)) << k;
   EXPECT_EQ(reader.counters().lost, 0);
   EXPECT_GT(reader.counters().recovered, 0);
 }
@@ -230,7 +232,8 @@ TEST(LossyBus, LargeMessagesAreMadeWholeFromTheFragmentsOfSeveralCopiesDespiteLo
     setenv("SEMX_TEST_JITTER_MS", "20", 1);
     sub_ptr = std::make_unique<Node>(options("sub", 1));
     unsetenv("SEMX_TEST_JITTER_MS");
-    sub_ptr->subscribe<semx::odometry_t>("ODOMETRY", [&](const semx::odometry_t& m) { odometry.push_back(m.utime); });
+    sub_ptr->subscribe<semx::odometry_t>("ODOMETRY",
+                                         [&](const semx::odometry_t& m) { odometry.push_back(m.utime); });
     sub_ptr->subscribe<semx::depth_image_t>("CAMERA_DEPTH",
                                             [&](const semx::depth_image_t& m) { frames.push_back(m.utime); });
   }

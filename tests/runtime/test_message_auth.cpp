@@ -62,8 +62,8 @@ TEST(MessageAuth, UnsignedTamperedAndWrongKeyedMessagesAreRefused) {
   EXPECT_EQ(verifier.verify("PLAN_PATH", plain.data(), plain.size()), AuthVerdict::kUnsigned);
   auto bytes = payload(100);
   signer.sign("PLAN_PATH", bytes);
-  for (std::size_t at : {std::size_t{0}, std::size_t{50}, std::size_t{99}, std::size_t{100 + 20},
-                         std::size_t{100 + 30}}) {
+  for (std::size_t at :
+       {std::size_t{0}, std::size_t{50}, std::size_t{99}, std::size_t{100 + 20}, std::size_t{100 + 30}}) {
     auto t = bytes;
     t[at] ^= 0x01;
     EXPECT_EQ(verifier.verify("PLAN_PATH", t.data(), t.size()), AuthVerdict::kForged) << "byte " << at;
@@ -75,7 +75,8 @@ TEST(MessageAuth, UnsignedTamperedAndWrongKeyedMessagesAreRefused) {
   MessageSigner forger(guess);
   auto f = payload(100);
   forger.sign("PLAN_PATH", f);
-  std::copy(bytes.end() - kAuthTrailerBytes, bytes.end() - kAuthTrailerBytes + 8, f.end() - kAuthTrailerBytes);
+  std::copy(bytes.end() - kAuthTrailerBytes, bytes.end() - kAuthTrailerBytes + 8,
+            f.end() - kAuthTrailerBytes);
   EXPECT_EQ(verifier.verify("PLAN_PATH", f.data(), f.size()), AuthVerdict::kForged);
   EXPECT_EQ(verifier.verify("PLAN_PATH", bytes.data(), bytes.size()), AuthVerdict::kOk);
 }

@@ -73,7 +73,8 @@ class FuelStrategy : public Strategy {
   // the coarse search from the vehicle (tree_path()). FUEL adds nothing.
   virtual void add_tour_costs(const PlanContext& /*ctx*/, const GridSearch& /*tree*/,
                               const std::vector<Eigen::Vector3d>& /*reps*/,
-                              const std::vector<Eigen::Vector3d>& /*means*/, TourProblem& /*problem*/) const {}
+                              const std::vector<Eigen::Vector3d>& /*means*/, TourProblem& /*problem*/) const {
+  }
   // ... and a cluster below FUEL's size thresholds that the tour visits with the large ones
   // instead of after them. FUEL promotes none.
   virtual bool promoted(const PlanContext& /*ctx*/, const FrontierClusters::Cluster& /*cluster*/) const {
@@ -92,8 +93,8 @@ class FuelStrategy : public Strategy {
   // A cluster as the tour sees it this plan.
   struct Site {
     int64_t cluster = -1;
-    std::vector<int> views;  // indices into views (top ones, reachable, not blacklisted)
-    int rep = -1;            // the representative among them
+    std::vector<int> views;                // indices into views (top ones, reachable, not blacklisted)
+    int rep = -1;                          // the representative among them
     std::vector<double> vehicle_distance;  // per view (of `views`)
   };
   struct Target {

@@ -46,22 +46,22 @@ struct OracleViewpoint {
 // What the oracle planned, in the planner's status and log.
 struct OracleSummary {
   bool ready = false;
-  std::string error;        // why there is no plan
-  int64_t target = 0;       // |T|
-  int64_t candidates = 0;   // viewpoints on the lattice that a goal may be (reachable, free)
-  int64_t observable = 0;   // voxels of T some candidate sees, at some yaw
-  int64_t covered = 0;      // ... that the picked viewpoints see
-  int64_t viewpoints = 0;   // picked
+  std::string error;       // why there is no plan
+  int64_t target = 0;      // |T|
+  int64_t candidates = 0;  // viewpoints on the lattice that a goal may be (reachable, free)
+  int64_t observable = 0;  // voxels of T some candidate sees, at some yaw
+  int64_t covered = 0;     // ... that the picked viewpoints see
+  int64_t viewpoints = 0;  // picked
   int64_t cover_dropped = 0;
-  int64_t first_pass = 0;   // viewpoints of the first tour (oracle.first_pass), the rest in the second
+  int64_t first_pass = 0;  // viewpoints of the first tour (oracle.first_pass), the rest in the second
   double first_pass_exponent = 0.0;  // the e of its ratio, and whether it is flown as a tour
   bool first_pass_toured = false;
-  bool first_pass_improved = false;             // reordered by the model's time to the target share
+  bool first_pass_improved = false;            // reordered by the model's time to the target share
   double first_pass_before_improvement = 0.0;  // s, the model's two times summed before that
-  double first_pass_target_time = 0.0;  // s, when it shows oracle.target_share of T by the model
-  double first_pass_early_time = 0.0;   // s, ... oracle.early_share
-  double tour_time = 0.0;    // s, the tour's summed leg costs
-  double tour_length = 0.0;  // m
+  double first_pass_target_time = 0.0;         // s, when it shows oracle.target_share of T by the model
+  double first_pass_early_time = 0.0;          // s, ... oracle.early_share
+  double tour_time = 0.0;                      // s, the tour's summed leg costs
+  double tour_length = 0.0;                    // m
   bool tour_exact = false;
   double prepare_ms = 0.0;  // wall time of the whole preparation (never charged: it stands for
                             // knowing the world beforehand)

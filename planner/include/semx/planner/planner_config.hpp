@@ -403,7 +403,7 @@ struct OracleConfig {
   // Objectives the first pass's reordering (Or-opt, 2-opt, drops judged by the model's time to
   // target_share of T) may ask for; 0: the schedule as chosen.
   int improve_evaluations = 3000;
-  int max_attempts = 5;     // plans toward one viewpoint (braked, rejected, held short) before it is skipped
+  int max_attempts = 5;  // plans toward one viewpoint (braked, rejected, held short) before it is skipped
   // Viewpoints one path flies through at most: on past a viewpoint while the turn into it takes
   // no longer than the flight (the heading keeps up), so the vehicle does not stop at each; 1:
   // one goal per viewpoint, the vehicle stopping and dwelling at every one.
@@ -415,7 +415,8 @@ struct OracleConfig {
 };
 
 struct PlannerConfig {
-  std::string planner = "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room | semantic-fuel
+  std::string planner =
+      "semantic-dep";  // semantic-dep | dep | nbv | aep | fuel | oracle | semantic-room | semantic-fuel
   int64_t seed = 1;
   double rate_hz = 4.0;  // planning cycles per simulated second, at most
   CollisionConfig collision;

@@ -47,7 +47,8 @@ double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector
 // improvement, until none improves or `max_evaluations` objectives were asked for: a segment of
 // 1-3 stops moved elsewhere (Or-opt), a segment reversed (2-opt), and with `may_drop` a stop
 // removed. Lower is better; the result is never worse than `order`.
-std::vector<int> improve_order(std::vector<int> order, const std::function<double(const std::vector<int>&)>& objective,
+std::vector<int> improve_order(std::vector<int> order,
+                               const std::function<double(const std::vector<int>&)>& objective,
                                int max_evaluations, bool may_drop);
 
 }  // namespace semx::planner

@@ -24,7 +24,9 @@ namespace semx::runtime {
 struct StreamKey {
   uint64_t sender = 0;
   uint32_t tag = 0;  // channel_tag(channel) (udpm_sender.hpp)
-  bool operator<(const StreamKey& o) const { return sender < o.sender || (sender == o.sender && tag < o.tag); }
+  bool operator<(const StreamKey& o) const {
+    return sender < o.sender || (sender == o.sender && tag < o.tag);
+  }
 };
 
 struct StreamHead {
@@ -47,8 +49,8 @@ struct InboxCounters {
 class Inbox {
  public:
   struct Options {
-    double retry_s = 0.05;      // wall seconds between requests for the same gap
-    double give_up_s = 3.0;     // wall seconds a gap is waited for before its messages count as lost
+    double retry_s = 0.05;   // wall seconds between requests for the same gap
+    double give_up_s = 3.0;  // wall seconds a gap is waited for before its messages count as lost
     std::size_t max_held_bytes = 64u << 20;  // beyond it the oldest gap is given up at once
     // A reader there from its set's start owes nothing to chance: every publisher's messages are
     // for it from seq 1 (the few sent before it subscribed are still kept for resending). One
@@ -110,8 +112,8 @@ class Inbox {
     bool resent_for = false;
   };
   struct Stream {
-    uint32_t next = 0;   // the next seq to hand over; 0: no start yet
-    uint32_t want = 0;   // the last seq known to exist (from a tick or a later message)
+    uint32_t next = 0;  // the next seq to hand over; 0: no start yet
+    uint32_t want = 0;  // the last seq known to exist (from a tick or a later message)
     std::map<uint32_t, Held> held;
     double gap_since = -1;
     double last_request = -1;  // the last time missing messages were asked for again
@@ -143,8 +145,8 @@ class ResendHistory {
   // Keeps `bytes` (the signed message as sent) as message `seq` of `channel`, taking its buffer;
   // gives back an old buffer to reuse. `wire_seqno`: the transport's seqno it went with (0:
   // none), under which a resend lets readers join its fragments with those they hold.
-  std::vector<uint8_t> keep(const std::string& channel, uint32_t tag, uint32_t seq, std::vector<uint8_t>&& bytes,
-                            uint32_t wire_seqno = 0);
+  std::vector<uint8_t> keep(const std::string& channel, uint32_t tag, uint32_t seq,
+                            std::vector<uint8_t>&& bytes, uint32_t wire_seqno = 0);
   // Message `seq` on the channel with `tag`, if still kept.
   const std::vector<uint8_t>* find(uint32_t tag, uint32_t seq, const std::string** channel,
                                    uint32_t* wire_seqno = nullptr) const;

@@ -29,8 +29,8 @@
 
 namespace semx::runtime {
 
-inline constexpr uint32_t kLcmMagicShort = 0x4c433032;  // "LC02"
-inline constexpr uint32_t kLcmMagicLong = 0x4c433033;   // "LC03"
+inline constexpr uint32_t kLcmMagicShort = 0x4c433032;    // "LC02"
+inline constexpr uint32_t kLcmMagicLong = 0x4c433033;     // "LC03"
 inline constexpr uint32_t kSemxMagicResend = 0x53585233;  // "SXR3"
 inline constexpr std::size_t kLcmShortHeader = 8;
 inline constexpr std::size_t kLcmLongHeader = 20;
@@ -121,7 +121,9 @@ class LcmReassembler {
   struct Key {
     uint64_t sender = 0;
     uint32_t seqno = 0;
-    bool operator<(const Key& o) const { return sender < o.sender || (sender == o.sender && seqno < o.seqno); }
+    bool operator<(const Key& o) const {
+      return sender < o.sender || (sender == o.sender && seqno < o.seqno);
+    }
     bool operator==(const Key& o) const { return sender == o.sender && seqno == o.seqno; }
   };
   struct Pending {

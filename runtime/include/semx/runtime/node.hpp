@@ -89,8 +89,8 @@ struct NodeCounters {
   int64_t dropped = 0;    // includes messages whose fragments did not all arrive
   int64_t malformed = 0;  // includes datagrams that are not LCM's (udpm_receiver.hpp)
   int64_t handler_errors = 0;
-  int64_t foreign = 0;  // another set's messages, ignored
-  int64_t refused = 0;  // unsigned, forged or replayed messages, dropped
+  int64_t foreign = 0;    // another set's messages, ignored
+  int64_t refused = 0;    // unsigned, forged or replayed messages, dropped
   int64_t lost = 0;       // messages missed and given up on (delivery.hpp): the run is not exact
   int64_t recovered = 0;  // messages missed and received again after a SIM_RESEND
   int64_t resent = 0;     // messages this node sent again on request
@@ -228,8 +228,7 @@ class Node {
   // Every message that arrives: its trailer is checked, then it goes to the typed and raw handlers.
   void on_signed_message(const std::string& channel, const uint8_t* data, std::size_t size);
   void on_message(const std::string& channel, const uint8_t* data, std::size_t size);
-  void on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size,
-                      std::size_t payload);
+  void on_raw_message(const std::string& channel, const uint8_t* data, std::size_t size, std::size_t payload);
   void note_refused(const std::string& channel, AuthVerdict verdict, const AuthTrailer& trailer);
   // Signs `bytes` (the payload) in place and sends it.
   bool send_signed(const std::string& channel, std::vector<uint8_t>& bytes);
@@ -303,8 +302,8 @@ class Node {
   // held tick or the last handled one names, those of senders that do not ack).
   bool may_deliver(const StreamKey& stream, uint32_t seq) const;
   // Hands a message over now, or keeps it until the tick that names it.
-  void deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size, const StreamKey& stream,
-                       uint32_t seq);
+  void deliver_in_turn(const std::string& channel, const uint8_t* data, std::size_t size,
+                       const StreamKey& stream, uint32_t seq);
   // Hands over the deferred messages that `heads` name (with `before_utime`, only those whose
   // time puts them before a tick at that utime: in_time), or with no heads those may_deliver()
   // lets go; each stream in its order, the rest in the order they came. `everything`: all.
@@ -314,7 +313,8 @@ class Node {
   // sensor data before the tick (utime <= the tick's), the others what a tick made after it.
   bool in_time(const StreamKey& stream, const uint8_t* payload, std::size_t size, int64_t tick_utime) const;
   bool in_lockstep() const {
-    return options_.follow_clock && !clock_source_ && clock_.started() && clock_.mode() == ClockMode::kLockstep;
+    return options_.follow_clock && !clock_source_ && clock_.started() &&
+           clock_.mode() == ClockMode::kLockstep;
   }
   uint64_t clock_sender_ = 0;    // the clock's source (SIM_CLOCK's signer)
   double last_clock_wall_ = -1;  // the last SIM_CLOCK heard (a new tick or a resent one)
@@ -323,7 +323,7 @@ class Node {
     std::vector<std::pair<int32_t, int32_t>> heads;  // (tag, seq)
   };
   std::map<std::string, AckHeads> ack_heads_;  // clock source: each node's latest ack
-  semx::clock_t sent_clock_{};                   // clock source: the last new tick, with its heads
+  semx::clock_t sent_clock_{};                 // clock source: the last new tick, with its heads
   int64_t sent_clock_tick_ = -1;
   bool clock_source_ = false;
   bool from_log_ = false;                // file:// provider: a log played back (on_signed_message)
