@@ -18,6 +18,7 @@
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_datagram.hpp"
 #include "semx/runtime/lcm_url.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/udpm_sender.hpp"
 
 namespace semx::runtime {
@@ -54,10 +55,6 @@ bool worth_logging(int64_t n) {
   if (n <= 5) return true;
   while (n % 10 == 0) n /= 10;
   return n == 1;
-}
-
-double wall_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 // Channels whose messages are numbered for resending: all but the clock's own protocol (a lost
@@ -307,7 +304,7 @@ void Node::on_signed_message(const std::string& channel, const uint8_t* data, st
   const bool in_order = tracked(channel) && trailer.seq != 0;  // seq 0: an observer's (send_signed)
   if (in_order) {
     const StreamKey stream{trailer.sender, channel_tag(channel)};
-    switch (inbox_.arrive(stream, trailer.seq, channel, data, size, wall_s())) {
+    switch (inbox_.arrive(stream, trailer.seq, channel, data, size, monotonic_s())) {
       case Inbox::Arrival::kDuplicate:
       case Inbox::Arrival::kHeld:
         return;
@@ -447,7 +444,7 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
                          static_cast<uint32_t>(a.head_seq[i])});
       }
       // What the clock itself reads (the controller's commands) must be held before the next tick.
-      inbox_.tick(named, wall_s());
+      inbox_.tick(named, monotonic_s());
     });
   }
   semx::clock_t m = msg;
@@ -486,7 +483,7 @@ bool Node::publish_clock(const std::string& channel, const semx::clock_t& msg) {
 }
 
 void Node::service_delivery() {
-  const double now = wall_s();
+  const double now = monotonic_s();
   inbox_.set_give_up_s(clock_.started() && clock_.mode() == ClockMode::kRealtime ? kGiveUpRealtimeS
                                                                                  : kGiveUpLockstepS);
   for (const ResendRequest& q : inbox_.requests(now)) {
@@ -666,7 +663,7 @@ bool Node::send_signed(const std::string& channel, std::vector<uint8_t>& bytes) 
 }
 
 void Node::on_clock_message(const semx::clock_t& msg) {
-  last_clock_wall_ = wall_s();
+  last_clock_wall_ = monotonic_s();
   // A tick already waiting (the clock sends it again until acked) changes nothing.
   for (const auto& h : held_ticks_) {
     if (h.msg.tick == msg.tick) return;
@@ -677,7 +674,7 @@ void Node::on_clock_message(const semx::clock_t& msg) {
     heads.push_back({{static_cast<uint64_t>(msg.head_sender[i]), static_cast<uint32_t>(msg.head_tag[i])},
                      static_cast<uint32_t>(msg.head_seq[i])});
   }
-  const bool complete = inbox_.tick(heads, wall_s());
+  const bool complete = inbox_.tick(heads, monotonic_s());
   HeldTick held{msg, {}};
   for (const StreamHead& h : heads) held.heads[h.stream] = std::max(held.heads[h.stream], h.seq);
   // In realtime a tick is not held for what it names: what is missing is asked for and handed
@@ -727,11 +724,11 @@ void Node::handle_tick(const semx::clock_t& msg, bool may_ack) {
   const bool skip_ack = decision.new_tick && !decision.reset && quiet_until_ > msg.utime &&
                         last_ack_utime_ >= 0 && msg.utime >= last_ack_utime_ &&
                         msg.utime - last_ack_utime_ < kAckIntervalUs;
-  const bool heads_ack = !decision.ack && may_ack && msg.mode == semx::clock_t::REALTIME &&
-                         !options_.observer && options_.sign &&
-                         wall_s() - last_heads_ack_wall_ >= kRealtimeHeadsPeriodS && !own_heads().empty();
+  const bool heads_ack =
+      !decision.ack && may_ack && msg.mode == semx::clock_t::REALTIME && !options_.observer &&
+      options_.sign && monotonic_s() - last_heads_ack_wall_ >= kRealtimeHeadsPeriodS && !own_heads().empty();
   if ((decision.ack && may_ack && !skip_ack) || heads_ack) {
-    if (heads_ack) last_heads_ack_wall_ = wall_s();
+    if (heads_ack) last_heads_ack_wall_ = monotonic_s();
     semx::ack_t ack{};
     ack.utime = msg.utime;
     ack.node = options_.name;

@@ -8,11 +8,11 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/udpm_sender.hpp"
 
 namespace semx::runtime {
@@ -225,9 +225,6 @@ void UdpmReceiver::filter(const std::vector<std::string>& channels, bool all,
 }
 
 namespace {
-double monotonic_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 uint64_t xorshift(uint64_t& state) {  // a test's own, repeatable draws
   state ^= state << 13;
   state ^= state >> 7;

@@ -1,6 +1,7 @@
 #include "semx/runtime/udpm_sender.hpp"
 
 #include "semx/runtime/executable_dir.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -28,10 +29,6 @@ void put32(uint8_t* p, uint32_t v) {
 void put16(uint8_t* p, uint16_t v) {
   p[0] = static_cast<uint8_t>(v >> 8);
   p[1] = static_cast<uint8_t>(v);
-}
-
-double monotonic_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace

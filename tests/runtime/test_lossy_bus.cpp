@@ -59,6 +59,37 @@ void spin_both(Node& a, Node& b, int ms) {
   }
 }
 
+// The publisher sends odometry at 200 Hz (a reader that keeps up, as a set's ticks make it) and a
+// depth frame of `frame_bytes` with every tenth, then ticks: a loss is known from a later message
+// on the same channel, or from a tick's heads, and a channel's last messages have nothing after
+// them, as a set's clock gives them. Checks that the reader got each message once, in order.
+void stream_and_check(Node& pub, Node& sub, int count, std::size_t frame_bytes,
+                      const std::vector<int64_t>& odometry, const std::vector<int64_t>& frames) {
+  for (int i = 1; i <= count; ++i) {
+    semx::odometry_t o{};
+    o.utime = i;
+    ASSERT_TRUE(pub.publish("ODOMETRY", o));
+    if (i % 10 == 0) {
+      ASSERT_TRUE(pub.publish("CAMERA_DEPTH", frame(i, frame_bytes)));
+    }
+    spin_both(pub, sub, 5);
+  }
+  for (int64_t tick = 0; tick < 20; ++tick) {
+    semx::clock_t c{};
+    c.tick = tick;
+    c.utime = 3000 + tick * 10;
+    c.mode = semx::clock_t::REALTIME;
+    c.period_us = 10;
+    pub.publish("SIM_CLOCK", c);
+    spin_both(pub, sub, 200);
+  }
+  std::vector<int64_t> want_odometry, want_frames;
+  for (int i = 1; i <= count; ++i) want_odometry.push_back(i);
+  for (int i = 10; i <= count; i += 10) want_frames.push_back(i);
+  EXPECT_EQ(odometry, want_odometry);
+  EXPECT_EQ(frames, want_frames);
+}
+
 }  // namespace
 
 TEST(LossyBus, EveryMessageArrivesInOrderDespiteTenPercentLoss) {
@@ -75,31 +106,7 @@ TEST(LossyBus, EveryMessageArrivesInOrderDespiteTenPercentLoss) {
   }
   Node& sub = *sub_ptr;
   // Large frames are many datagrams each: at 10 % loss most would be lost whole.
-  for (int i = 1; i <= 300; ++i) {
-    semx::odometry_t o{};
-    o.utime = i;
-    ASSERT_TRUE(pub.publish("ODOMETRY", o));
-    if (i % 10 == 0) {
-      ASSERT_TRUE(pub.publish("CAMERA_DEPTH", frame(i, 600000)));
-    }
-    spin_both(pub, sub, 5);  // 200 Hz: a reader that keeps up, as a set's ticks make it
-  }
-  // A loss is known from a later message on the same channel, or from a tick's heads: the last
-  // messages of a channel have nothing after them, so the publisher ticks, as a set's clock does.
-  for (int64_t tick = 0; tick < 20; ++tick) {
-    semx::clock_t c{};
-    c.tick = tick;
-    c.utime = 3000 + tick * 10;
-    c.mode = semx::clock_t::REALTIME;
-    c.period_us = 10;
-    pub.publish("SIM_CLOCK", c);
-    spin_both(pub, sub, 200);
-  }
-  std::vector<int64_t> want_odometry, want_frames;
-  for (int i = 1; i <= 300; ++i) want_odometry.push_back(i);
-  for (int i = 10; i <= 300; i += 10) want_frames.push_back(i);
-  EXPECT_EQ(odometry, want_odometry);
-  EXPECT_EQ(frames, want_frames);
+  stream_and_check(pub, sub, 300, 600000, odometry, frames);
   EXPECT_GT(sub.counters().recovered, 10) << "no loss: the drop filter did not work";
   EXPECT_EQ(sub.counters().lost, 0);
   EXPECT_GT(pub.counters().resent, 0);
@@ -238,29 +245,7 @@ TEST(LossyBus, LargeMessagesAreMadeWholeFromTheFragmentsOfSeveralCopiesDespiteLo
                                             [&](const semx::depth_image_t& m) { frames.push_back(m.utime); });
   }
   Node& sub = *sub_ptr;
-  for (int i = 1; i <= 200; ++i) {
-    semx::odometry_t o{};
-    o.utime = i;
-    ASSERT_TRUE(pub.publish("ODOMETRY", o));
-    if (i % 10 == 0) {
-      ASSERT_TRUE(pub.publish("CAMERA_DEPTH", frame(i, 1200000)));
-    }
-    spin_both(pub, sub, 5);
-  }
-  for (int64_t tick = 0; tick < 20; ++tick) {
-    semx::clock_t c{};
-    c.tick = tick;
-    c.utime = 3000 + tick * 10;
-    c.mode = semx::clock_t::REALTIME;
-    c.period_us = 10;
-    pub.publish("SIM_CLOCK", c);
-    spin_both(pub, sub, 200);
-  }
-  std::vector<int64_t> want_odometry, want_frames;
-  for (int i = 1; i <= 200; ++i) want_odometry.push_back(i);
-  for (int i = 10; i <= 200; i += 10) want_frames.push_back(i);
-  EXPECT_EQ(odometry, want_odometry);
-  EXPECT_EQ(frames, want_frames);
+  stream_and_check(pub, sub, 200, 1200000, odometry, frames);
   EXPECT_EQ(sub.counters().lost, 0);
   EXPECT_GT(sub.counters().recovered, 5) << "no loss: the drop filter did not work";
   // Whole copies would take ~70 resends a frame (1400 here); filling holes takes a few, plus

@@ -14,6 +14,17 @@ namespace {
 
 std::vector<uint8_t> payload(std::size_t n, uint8_t fill = 7) { return std::vector<uint8_t>(n, fill); }
 
+// `n` messages of one sender on `channel`, signed in order (counters 1..n).
+std::vector<std::vector<uint8_t>> signed_series(MessageSigner& signer, const std::string& channel, int n) {
+  std::vector<std::vector<uint8_t>> sent;
+  for (int i = 0; i < n; ++i) {
+    auto b = payload(20, static_cast<uint8_t>(i));
+    signer.sign(channel, b);
+    sent.push_back(b);
+  }
+  return sent;
+}
+
 }  // namespace
 
 TEST(MessageAuth, WhatASetSignsItsReadersAccept) {
@@ -85,12 +96,7 @@ TEST(MessageAuth, ReplaysAreRefusedReorderingWithinTheWindowIsNot) {
   const AuthKey key = AuthKey::random();
   MessageSigner signer(key);
   MessageVerifier verifier(key);
-  std::vector<std::vector<uint8_t>> sent;
-  for (int i = 0; i < 100; ++i) {
-    auto b = payload(20, static_cast<uint8_t>(i));
-    signer.sign("ODOMETRY", b);
-    sent.push_back(b);
-  }
+  const auto sent = signed_series(signer, "ODOMETRY", 100);
   EXPECT_EQ(verifier.verify("ODOMETRY", sent[10].data(), sent[10].size()), AuthVerdict::kOk);
   EXPECT_EQ(verifier.verify("ODOMETRY", sent[10].data(), sent[10].size()), AuthVerdict::kReplayed);
   EXPECT_EQ(verifier.verify("ODOMETRY", sent[5].data(), sent[5].size()), AuthVerdict::kOk);  // late, not seen
@@ -107,12 +113,7 @@ TEST(MessageAuth, AResendAwaitedIsAuthenticBeyondTheWindowAndAForgedOneIsNot) {
   const AuthKey key = AuthKey::random();
   MessageSigner signer(key);
   MessageVerifier verifier(key);
-  std::vector<std::vector<uint8_t>> sent;
-  for (int i = 0; i < 100; ++i) {
-    auto b = payload(20, static_cast<uint8_t>(i));
-    signer.sign("ESDF_LOCAL", b);
-    sent.push_back(b);
-  }
+  const auto sent = signed_series(signer, "ESDF_LOCAL", 100);
   EXPECT_EQ(verifier.verify("ESDF_LOCAL", sent[99].data(), sent[99].size()), AuthVerdict::kOk);
   EXPECT_EQ(verifier.verify("ESDF_LOCAL", sent[3].data(), sent[3].size()), AuthVerdict::kReplayed);
   EXPECT_TRUE(verifier.authentic("ESDF_LOCAL", sent[3].data(), sent[3].size()));
