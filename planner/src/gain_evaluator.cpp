@@ -234,11 +234,12 @@ void GainEvaluator::prepare(double res) {
   const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
   seen_.assign((bits + 63) / 64, 0);
   surface_.assign(seen_.size(), 0);
-  // Blocks an offset can fall in, relative to the node's block, whatever the node's place in it.
-  block_lo_ = (-hx_) >> map::kBlockBits;
-  block_n_ = ((map::kBlockMask + hx_) >> map::kBlockBits) - block_lo_ + 1;
-  block_lo_z_ = (-hz_) >> map::kBlockBits;
-  const int nz = ((map::kBlockMask + hz_) >> map::kBlockBits) - block_lo_z_ + 1;
+  // Blocks an offset or one of its face neighbours can fall in, relative to the node's block,
+  // whatever the node's place in it.
+  block_lo_ = (-hx_ - 1) >> map::kBlockBits;
+  block_n_ = ((map::kBlockMask + hx_ + 1) >> map::kBlockBits) - block_lo_ + 1;
+  block_lo_z_ = (-hz_ - 1) >> map::kBlockBits;
+  const int nz = ((map::kBlockMask + hz_ + 1) >> map::kBlockBits) - block_lo_z_ + 1;
   block_ptr_.assign(static_cast<size_t>(block_n_) * block_n_ * nz, nullptr);
   block_stamp_.assign(block_ptr_.size(), 0u);
   ignored_ptr_.assign(block_ptr_.size(), nullptr);
@@ -272,7 +273,6 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
   }
   const bool occlude = config_.surface_occludes;
   const int nx = 2 * hx_ + 1;
-  map::StateGrid::Reader neighbour_reader = grid.reader();
   const VoxelKey origin_block = map::block_of(origin);
   const int ox = origin.x & map::kBlockMask, oy = origin.y & map::kBlockMask, oz = origin.z & map::kBlockMask;
   const map::VoxelBlock* origin_b = grid.find_block(origin_block);
@@ -282,6 +282,38 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
     std::fill(block_stamp_.begin(), block_stamp_.end(), 0u);
     stamp_ = 1;
   }
+  // The block at (bx, by, bz) blocks from the node's, looked up once per evaluation.
+  auto slot_of = [&](int bx, int by, int bz) {
+    const size_t slot =
+        static_cast<size_t>((bx - block_lo_) + block_n_ * ((by - block_lo_) + block_n_ * (bz - block_lo_z_)));
+    if (block_stamp_[slot] != stamp_) {
+      block_stamp_[slot] = stamp_;
+      const VoxelKey block{origin_block.x + bx, origin_block.y + by, origin_block.z + bz};
+      block_ptr_[slot] = grid.find_block(block);
+      ignored_ptr_[slot] = ignore ? ignored_->block_mask(block) : nullptr;
+    }
+    return slot;
+  };
+  // A voxel's state by its offset from the node's block origin: a voxel on a block's face has
+  // neighbours in the next block, and the cursor of StateGrid::Reader, which holds one block,
+  // went back to the hash map for them once or twice per voxel.
+  auto state_at = [&](int ux, int uy, int uz) {
+    const map::VoxelBlock* nb =
+        block_ptr_[slot_of(ux >> map::kBlockBits, uy >> map::kBlockBits, uz >> map::kBlockBits)];
+    if (!nb) return VoxelState::kUnknown;
+    const int lx = ux & map::kBlockMask, ly = uy & map::kBlockMask, lz = uz & map::kBlockMask;
+    return nb->state[static_cast<size_t>(lx | (ly << map::kBlockBits) | (lz << (2 * map::kBlockBits)))];
+  };
+  auto border_kind = [&](int ux, int uy, int uz) {
+    const VoxelState n[6] = {state_at(ux - 1, uy, uz), state_at(ux + 1, uy, uz), state_at(ux, uy - 1, uz),
+                             state_at(ux, uy + 1, uz), state_at(ux, uy, uz - 1), state_at(ux, uy, uz + 1)};
+    bool free = false, occupied = false;
+    for (const VoxelState v : n) {
+      free |= v == VoxelState::kFree;
+      occupied |= v == VoxelState::kOccupied;
+    }
+    return free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
+  };
   int64_t steps = 0;
   for (size_t ray = 0; ray < directions_.size(); ++ray) {
     const int ray_bin = direction_bin_[ray];
@@ -301,14 +333,7 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
         cur_by = by;
         cur_bz = bz;
         // Rays cross ~4 blocks each and share them: each block is looked up once per evaluation.
-        const size_t slot = static_cast<size_t>(
-            (bx - block_lo_) + block_n_ * ((by - block_lo_) + block_n_ * (bz - block_lo_z_)));
-        if (block_stamp_[slot] != stamp_) {
-          block_stamp_[slot] = stamp_;
-          const VoxelKey block{origin_block.x + bx, origin_block.y + by, origin_block.z + bz};
-          block_ptr_[slot] = grid.find_block(block);
-          ignored_ptr_[slot] = ignore ? ignored_->block_mask(block) : nullptr;
-        }
+        const size_t slot = slot_of(bx, by, bz);
         b = block_ptr_[slot];
         ignored_mask = ignored_ptr_[slot];
       }
@@ -351,11 +376,14 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
       }
       if (occlude) {
         // The kind decides whether the ray goes on, inside the sector or not.
-        if (!known_kind) known_kind = classify(neighbour_reader, k, kind);
+        if (!known_kind) {
+          kind = border_kind(ux, uy, uz);
+          known_kind = true;
+        }
         if (kind == GainVoxel::kSurface) surface_[bit >> 6] |= mask;
       }
-      if (in_sector(c) && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li))) &&
-          (known_kind || classify(neighbour_reader, k, kind))) {
+      if (in_sector(c) && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li)))) {
+        if (!known_kind) kind = border_kind(ux, uy, uz);
         const int bin = bin_near(c, ray_bin);
         add(g, bin, kind);
         if (counted && in_window(bin)) counted->push_back(k);
