@@ -6,7 +6,6 @@
 #include <semx/sim_event_t.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -14,6 +13,7 @@
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/executable_dir.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
 #include "simulator_messages.hpp"
 
@@ -22,9 +22,6 @@ namespace semx::simulator {
 namespace ch = semx::channels;
 
 namespace {
-double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 constexpr uint32_t kStateKind = runtime::state_kind("SIMS");
 }  // namespace
 
@@ -33,7 +30,7 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
   node_.subscribe<semx::control_cmd_t>(
       ch::CONTROL_CMD, [this](const semx::control_cmd_t& m) { on_command(m); }, &well_formed);
   node_.subscribe<semx::ack_t>(ch::SIM_ACK, [this](const semx::ack_t& a) {
-    server_.on_ack(a.node, a.tick, a.quiet_until, wall_seconds());
+    server_.on_ack(a.node, a.tick, a.quiet_until, semx::runtime::monotonic_s());
   });
   next_progress_s_ = options_.progress_every_s;
   if (options_.clock.mode == runtime::ClockMode::kLockstep && options_.foreign_hold_s > 0 &&
@@ -46,7 +43,7 @@ SimulatorNode::SimulatorNode(Simulator& sim, runtime::Node& node, SimulatorNodeO
     // Read before the slot is opened, which empties the file.
     const auto saved = options_.resume ? runtime::read_state_slot(options_.state_path, kStateKind)
                                        : std::optional<std::vector<uint8_t>>();
-    if (saved) restore_state(*saved, wall_seconds());
+    if (saved) restore_state(*saved, semx::runtime::monotonic_s());
     state_ = std::make_unique<runtime::StateSlot>(options_.state_path, kStateKind);
   }
   const auto& nodes = options_.clock.lockstep_nodes;
@@ -86,7 +83,8 @@ void SimulatorNode::restore_state(const std::vector<uint8_t>& bytes, double wall
   }
   const std::size_t header = bytes.size() - r.remaining();
   try {
-    sim_.restore_state(std::vector<uint8_t>(bytes.begin() + static_cast<std::ptrdiff_t>(header), bytes.end()));
+    sim_.restore_state(
+        std::vector<uint8_t>(bytes.begin() + static_cast<std::ptrdiff_t>(header), bytes.end()));
   } catch (const std::runtime_error& e) {
     throw runtime::StateFileError(options_.state_path + ": " + e.what());
   }
@@ -192,7 +190,7 @@ bool SimulatorNode::poll(double wall_s) {
       if (state_) save_state(t->tick);
     }
     publish_clock(*t);
-    if (!t->resend) server_.mark_published(wall_seconds());
+    if (!t->resend) server_.mark_published(semx::runtime::monotonic_s());
     const double sim_s = static_cast<double>(t->utime) * 1e-6;
     if (options_.progress_every_s > 0 && sim_s >= next_progress_s_) {
       const auto o = sim_.odometry();
@@ -210,7 +208,7 @@ int SimulatorNode::run() {
   node_.set_state(runtime::NodeState::kRunning, sim_.world().name);
   const bool lockstep = options_.clock.mode == runtime::ClockMode::kLockstep;
   while (!node_.stopped()) {
-    const double now = wall_seconds();
+    const double now = semx::runtime::monotonic_s();
     if (!poll(now)) break;
     // Lockstep with acks to wait for, or realtime between ticks: sleep in LCM until something
     // arrives (an ack, a command) or 1 ms passes. Lockstep with nobody to wait for: no sleep.
@@ -218,7 +216,7 @@ int SimulatorNode::run() {
       if (node_.spin_once(1) < 0) return 1;
     }
   }
-  const double wall = wall_seconds() - wall_start_;
+  const double wall = semx::runtime::monotonic_s() - wall_start_;
   const double sim_s = static_cast<double>(sim_.time_us()) * 1e-6;
   if (server_.finished()) {
     publish_event(semx::sim_event_t::EPISODE_END, "time limit", sim_.odometry().position, -1, 1);

@@ -15,6 +15,7 @@
 
 #include "semx/bench/bench_scheduler.hpp"
 #include "semx/runtime/args.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 
 namespace semx::bench {
 namespace {
@@ -154,7 +155,7 @@ TEST(BenchScheduler, RunsEachPlanEntryAndKeepsWhatIsDone) {
   SchedulerOptions o = fake_options(root);
   const std::vector<BenchRun> runs = {{"env1", "dep", "45", 1, "300"}, {"env1", "aep", "45", 1, "300"}};
   std::ostringstream out;
-  EXPECT_EQ(run_bench(runs, o, out, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, out, runtime::monotonic_s()), 0);
   const auto l = lines(out.str());
   ASSERT_EQ(l.size(), 2u) << out.str();
   EXPECT_EQ(
@@ -172,7 +173,7 @@ TEST(BenchScheduler, RunsEachPlanEntryAndKeepsWhatIsDone) {
   // Again: the finished run is kept, the failed one runs again (in a fresh folder).
   std::ofstream(dir + "/stale") << "x";
   std::ostringstream again;
-  EXPECT_EQ(run_bench(runs, o, again, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, again, runtime::monotonic_s()), 0);
   EXPECT_EQ(lines(again.str())[0], "[1/2] env1-dep-s45-seed1: done before, kept");
   EXPECT_TRUE(contains(again.str(), "[2/2] env1-aep-s45-seed1: FAILED (exit 3)"));
   EXPECT_FALSE(fs::exists(dir + "/stale"));
@@ -181,7 +182,7 @@ TEST(BenchScheduler, RunsEachPlanEntryAndKeepsWhatIsDone) {
   fs::remove_all(o.out_dir + "/runs/env1-dep-s45-seed1");
   o.keep_logs = true;
   std::ostringstream logs;
-  run_bench({runs[0]}, o, logs, steady_now_s());
+  run_bench({runs[0]}, o, logs, runtime::monotonic_s());
   EXPECT_TRUE(fs::exists(o.out_dir + "/runs/env1-dep-s45-seed1/run.lcmlog"));
   fs::remove_all(root);
 }
@@ -192,24 +193,25 @@ TEST(BenchScheduler, ARunStoppedBeforeItsEndRunsAgainAndWhatItLeftIsKeptAside) {
   const std::vector<BenchRun> runs = {{"env1", "dep", "45", 1, "300"}};
   setenv("TERMINATION", "stopped", 1);
   std::ostringstream first;
-  EXPECT_EQ(run_bench(runs, o, first, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, first, runtime::monotonic_s()), 0);
   unsetenv("TERMINATION");
   const std::string dir = o.out_dir + "/runs/env1-dep-s45-seed1";
   std::ofstream(dir + "/mine") << "x";
 
   std::ostringstream again;
-  EXPECT_EQ(run_bench(runs, o, again, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, again, runtime::monotonic_s()), 0);
   const auto l = lines(again.str());
   ASSERT_EQ(l.size(), 2u) << again.str();
   const std::string aside = o.out_dir + "/interrupted/env1-dep-s45-seed1-1";
-  EXPECT_EQ(l[0], "[1/1] env1-dep-s45-seed1: stopped before its end last time, run again (moved to " + aside + ")");
+  EXPECT_EQ(l[0],
+            "[1/1] env1-dep-s45-seed1: stopped before its end last time, run again (moved to " + aside + ")");
   EXPECT_EQ(l[1].rfind("[1/1] env1-dep-s45-seed1: coverage 98.8 %", 0), 0u) << l[1];
   EXPECT_EQ(read(aside + "/mine"), "x");  // nothing the stopped run left is lost
   EXPECT_FALSE(fs::exists(dir + "/mine"));
 
   // Finished now: kept.
   std::ostringstream third;
-  EXPECT_EQ(run_bench(runs, o, third, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, third, runtime::monotonic_s()), 0);
   EXPECT_EQ(lines(third.str())[0], "[1/1] env1-dep-s45-seed1: done before, kept");
   fs::remove_all(root);
 }
@@ -218,7 +220,8 @@ TEST(BenchScheduler, SlotUrlsFollowTheBaseUrl) {
   EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304", 2),
             "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=4194304");
   // LCM_DEFAULT_URL as docs showed it: the receive buffer the bench needs is added.
-  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7711?ttl=0", 0), "udpm://239.255.76.67:7711?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7711?ttl=0", 0),
+            "udpm://239.255.76.67:7711?ttl=0&recv_buf_size=4194304");
   EXPECT_EQ(slot_lcm_url("udpm://239.255.76.68:7711", 1), "udpm://239.255.76.68:7712?recv_buf_size=4194304");
   EXPECT_EQ(slot_lcm_url("udpm://239.255.76.67:7711?recv_buf_size=8388608&ttl=0", 0, 9000),
             "udpm://239.255.76.67:9000?recv_buf_size=8388608&ttl=0");
@@ -236,7 +239,7 @@ TEST(BenchScheduler, SlotsRunAtOnceEachOnItsPort) {
   const std::vector<BenchRun> runs = {
       {"env1", "dep", "45", 1, "300"}, {"env1", "dep", "45", 2, "300"}, {"env1", "dep", "45", 3, "300"}};
   std::ostringstream out;
-  EXPECT_EQ(run_bench(runs, o, out, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, out, runtime::monotonic_s()), 0);
   unsetenv("WAIT_FOR");
   EXPECT_EQ(lines(out.str()).size(), 3u) << out.str();
   EXPECT_EQ(read(o.out_dir + "/runs/env1-dep-s45-seed1/url.txt"),
@@ -255,14 +258,14 @@ TEST(BenchScheduler, SigintStartsNoMoreRunsAndARerunContinues) {
   // not started.
   const std::vector<BenchRun> runs = {{"env1", "nbv", "45", 1, "300"}, {"env1", "dep", "45", 1, "300"}};
   std::ostringstream out;
-  EXPECT_EQ(run_bench(runs, o, out, steady_now_s()), 130);
+  EXPECT_EQ(run_bench(runs, o, out, runtime::monotonic_s()), 130);
   const auto l = lines(out.str());
   ASSERT_EQ(l.size(), 1u) << out.str();
   EXPECT_EQ(l[0].rfind("[1/2] env1-nbv-s45-seed1: coverage 98.8 %", 0), 0u);
   EXPECT_FALSE(fs::exists(o.out_dir + "/runs/env1-dep-s45-seed1"));
 
   std::ostringstream again;
-  EXPECT_EQ(run_bench(runs, o, again, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, again, runtime::monotonic_s()), 0);
   const auto m = lines(again.str());
   ASSERT_EQ(m.size(), 2u) << again.str();
   EXPECT_EQ(m[0], "[1/2] env1-nbv-s45-seed1: done before, kept");
@@ -276,7 +279,7 @@ TEST(BenchScheduler, ASigintIgnoredOnEntryStaysIgnored) {
   signal(SIGINT, SIG_IGN);  // a bench started with & from a script
   const std::vector<BenchRun> runs = {{"env1", "nbv", "45", 1, "300"}, {"env1", "dep", "45", 1, "300"}};
   std::ostringstream out;
-  EXPECT_EQ(run_bench(runs, o, out, steady_now_s()), 0);
+  EXPECT_EQ(run_bench(runs, o, out, runtime::monotonic_s()), 0);
   signal(SIGINT, SIG_DFL);
   EXPECT_EQ(lines(out.str()).size(), 2u) << out.str();
   fs::remove_all(root);
@@ -287,7 +290,7 @@ TEST(BenchScheduler, AMissingLauncherIsAFailedRun) {
   SchedulerOptions o = fake_options(root);
   o.launcher = root + "/no-such-launcher";
   std::ostringstream out;
-  EXPECT_EQ(run_bench({{"env1", "dep", "45", 1, "300"}}, o, out, steady_now_s()), 0);
+  EXPECT_EQ(run_bench({{"env1", "dep", "45", 1, "300"}}, o, out, runtime::monotonic_s()), 0);
   EXPECT_TRUE(contains(out.str(), "[1/1] env1-dep-s45-seed1: FAILED (exit 127)")) << out.str();
   EXPECT_TRUE(contains(read(o.out_dir + "/runs/env1-dep-s45-seed1/launch.log"), "cannot run"));
   fs::remove_all(root);

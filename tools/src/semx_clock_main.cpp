@@ -4,12 +4,12 @@
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 
-#include <chrono>
 #include <iostream>
 #include <sstream>
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/clock_server.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/node_flags.hpp"
 
 using namespace semx::runtime;
@@ -23,10 +23,6 @@ std::vector<std::string> split_list(const std::string& s) {
     if (!item.empty()) out.push_back(item);
   }
   return out;
-}
-
-double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace
@@ -83,7 +79,7 @@ int main(int argc, char** argv) {
 
     bool warned = false;
     while (!node.stopped() && !server.finished()) {
-      const double now = wall_seconds();
+      const double now = semx::runtime::monotonic_s();
       if (auto t = server.poll(now, node.holds_everything())) {
         semx::clock_t c{};
         c.utime = t->utime;

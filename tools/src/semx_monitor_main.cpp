@@ -3,24 +3,20 @@
 // doubles as a readiness check for scripts: exit 0 once the named nodes run, 1 on --timeout.
 #include <semx/node_status_t.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
 
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_schema.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/node_flags.hpp"
 #include "semx/runtime/wire_validator.hpp"
 #include "semx/tools/status_board.hpp"
 
 using namespace semx::runtime;
 
-namespace {
-double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
+namespace {}  // namespace
 
 int main(int argc, char** argv) {
   return run_main("semx-monitor", [&] {
@@ -51,7 +47,7 @@ int main(int argc, char** argv) {
     install_shutdown_handlers();
     semx::tools::StatusBoard board;
     node.subscribe<semx::node_status_t>(semx::channels::NODE_STATUS, [&](const semx::node_status_t& s) {
-      board.on_status(s, wall_seconds());
+      board.on_status(s, semx::runtime::monotonic_s());
     });
     if (channels) {
       // Validate every known channel's bytes as they pass, independent of any subscriber.
@@ -66,12 +62,12 @@ int main(int argc, char** argv) {
     }
     node.set_state(NodeState::kRunning);
 
-    const double start = wall_seconds();
+    const double start = semx::runtime::monotonic_s();
     board.update_rates(start);
     double next_report = start + interval;
     while (!node.stopped()) {
       if (node.spin_once(50) < 0) return 1;
-      const double now = wall_seconds();
+      const double now = semx::runtime::monotonic_s();
       if (!expected.empty() && board.missing(expected).empty()) {
         std::cout << board.render_nodes(now) << "semx-monitor: all expected nodes are up\n";
         return 0;

@@ -4,13 +4,12 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
-#include <sys/stat.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <deque>
@@ -21,6 +20,7 @@
 #include <vector>
 
 #include "semx/runtime/config.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/restart_count.hpp"
 
 namespace semx::tools {
@@ -34,10 +34,6 @@ extern "C" void on_supervisor_signal(int sig) {
   const char c = static_cast<char>(sig);
   [[maybe_unused]] ssize_t n = write(g_signal_pipe[1], &c, 1);
   errno = saved;
-}
-
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 struct Child {
@@ -77,7 +73,7 @@ class Supervisor {
     for (const auto& p : set.processes) width = std::max(width, p.name.size());
     width_ = width;
     int k = 0;
-    const double t0 = now_s();
+    const double t0 = semx::runtime::monotonic_s();
     const std::string log_dir = o.log_dir.empty() ? set.log_dir : o.log_dir;
     log_dir_ = log_dir;
     if (!log_dir.empty()) {
@@ -105,11 +101,11 @@ class Supervisor {
   }
 
   int run() {
-    const double t0 = now_s();
+    const double t0 = semx::runtime::monotonic_s();
     say("set '" + set_.name + "': " + std::to_string(children_.size()) + " processes" +
         (o_.lcm_url.empty() ? "" : " on " + o_.lcm_url));
     while (true) {
-      const double t = now_s();
+      const double t = semx::runtime::monotonic_s();
       if (!stopping_ && o_.duration_s > 0 && t - t0 >= o_.duration_s) {
         say("duration of " + std::to_string(o_.duration_s) + " s reached");
         begin_stop(0);
@@ -263,8 +259,9 @@ class Supervisor {
     fcntl(fds[0], F_SETFL, O_NONBLOCK);
     c.pid = pid;
     c.out_fd = fds[0];
-    c.started_at = now_s();
-    say(c, (c.restarts > 0 ? "restarted (pid " : "started (pid ") + std::to_string(pid) + "): " + join(argv_s));
+    c.started_at = semx::runtime::monotonic_s();
+    say(c,
+        (c.restarts > 0 ? "restarted (pid " : "started (pid ") + std::to_string(pid) + "): " + join(argv_s));
   }
 
   static std::string join(const std::vector<std::string>& v) {
@@ -290,8 +287,9 @@ class Supervisor {
             say(std::string("caught ") + (sig[i] == SIGINT ? "SIGINT" : "SIGTERM") +
                 ": stopping all processes");
             begin_stop(130);
-            signalled_at_ = now_s();
-          } else if (!killed_ && (signalled_at_ < 0 || now_s() - signalled_at_ > kSameSignalS)) {
+            signalled_at_ = semx::runtime::monotonic_s();
+          } else if (!killed_ &&
+                     (signalled_at_ < 0 || semx::runtime::monotonic_s() - signalled_at_ > kSameSignalS)) {
             say("second signal: SIGKILL now");
             kill_at_ = 0;
           }
@@ -318,15 +316,16 @@ class Supervisor {
         c.pid = -1;
         flush(c);
         const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        const std::string how = (WIFEXITED(status) ? "exited with " + std::to_string(code)
-                                                   : std::string("killed by signal ") + strsignal(WTERMSIG(status))) +
-                                peak;
+        const std::string how =
+            (WIFEXITED(status) ? "exited with " + std::to_string(code)
+                               : std::string("killed by signal ") + strsignal(WTERMSIG(status))) +
+            peak;
         const ExitAction action = on_process_exit(*c.spec, code, c.restarts, stopping_);
         if (code != 0 && !stopping_) show_recent(c);
         switch (action) {
           case ExitAction::kRestart: {
             ++c.restarts;
-            const double t = now_s();
+            const double t = semx::runtime::monotonic_s();
             // A process that ran for a while was healthy: its next failure starts the backoff over.
             c.in_a_row = t - c.started_at > c.spec->restart_delay_max_s ? 1 : c.in_a_row + 1;
             const double delay = restart_delay(*c.spec, c.in_a_row);
@@ -367,7 +366,7 @@ class Supervisor {
     if (stopping_) return;
     stopping_ = true;
     exit_code_ = code;
-    kill_at_ = now_s() + o_.grace_s;
+    kill_at_ = semx::runtime::monotonic_s() + o_.grace_s;
     for (auto& c : children_) {
       c.pending = false;
       if (c.pid > 0) kill(-c.pid, SIGINT);

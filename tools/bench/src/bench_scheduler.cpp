@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +21,7 @@
 
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/lcm_url.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 
 namespace semx::bench {
 
@@ -191,10 +191,6 @@ struct Active {
 
 }  // namespace
 
-double steady_now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 std::string slot_lcm_url(const std::string& base_url, int slot, int port) {
   const std::string scheme = "udpm://";
   const std::size_t q = base_url.find('?');
@@ -202,7 +198,8 @@ std::string slot_lcm_url(const std::string& base_url, int slot, int port) {
   std::string opts = q == std::string::npos ? "" : base_url.substr(q + 1);
   const std::size_t colon = address.rfind(':');
   if (address.rfind(scheme, 0) != 0 || colon == std::string::npos || colon < scheme.size()) {
-    throw runtime::ArgError("LCM URL '" + base_url + "': the bench needs udpm://ADDRESS:PORT (one port per slot)");
+    throw runtime::ArgError("LCM URL '" + base_url +
+                            "': the bench needs udpm://ADDRESS:PORT (one port per slot)");
   }
   int base = port;
   if (base < 0) {
@@ -213,10 +210,11 @@ std::string slot_lcm_url(const std::string& base_url, int slot, int port) {
     base = std::stoi(digits);
   }
   if (base + slot > 65535) {
-    throw runtime::ArgError("LCM port " + std::to_string(base) + " + slot " + std::to_string(slot) + " is past 65535");
+    throw runtime::ArgError("LCM port " + std::to_string(base) + " + slot " + std::to_string(slot) +
+                            " is past 65535");
   }
   return runtime::with_receive_buffer(address.substr(0, colon + 1) + std::to_string(base + slot) +
-                                     (opts.empty() ? "" : "?" + opts));
+                                      (opts.empty() ? "" : "?" + opts));
 }
 
 std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::string& dir,
@@ -226,8 +224,8 @@ std::vector<std::string> launch_argv(const BenchRun& run, int slot, const std::s
   // bench would delete.
   if (!o.keep_logs) argv.insert(argv.end(), {"--without", "logger"});
   // The run's key stays in its folder, so its log can be checked and replayed (./semx eval).
-  argv.insert(argv.end(), {"--no-color", "--lcm-url", slot_lcm_url(o.base_url, slot), "--key-out",
-                           dir + "/session.key"});
+  argv.insert(argv.end(),
+              {"--no-color", "--lcm-url", slot_lcm_url(o.base_url, slot), "--key-out", dir + "/session.key"});
   for (const std::string& a :
        {"world=" + run.world, "planner=" + run.planner, "seed=" + std::to_string(run.seed),
         "samples=" + run.samples, "clock=" + o.clock, "time_limit=" + run.time_limit, "out=" + dir,
@@ -304,7 +302,7 @@ int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std:
     // 130: the set was interrupted (Ctrl-C reaches every launcher); the bench says so at the end.
     if (code != 130) {
       if (is_regular_file(a.dir + "/metrics.csv")) {
-        const auto elapsed = static_cast<int64_t>(std::floor(steady_now_s() - t0_s));
+        const auto elapsed = static_cast<int64_t>(std::floor(runtime::monotonic_s() - t0_s));
         if (auto line = result_line(a.k, total, a.name, read_text(a.dir + "/metrics.csv"), elapsed))
           say(*line);
       } else {
@@ -392,7 +390,8 @@ int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std:
       // A run cut short (Ctrl-C, a killed set) wrote metrics.json too; it is run again, and what
       // it left is kept aside where the report does not read it.
       const std::string aside = set_aside(o.out_dir, run.name());
-      say(run_tag(k, total, run.name()) + ": stopped before its end last time, run again (moved to " + aside + ")");
+      say(run_tag(k, total, run.name()) + ": stopped before its end last time, run again (moved to " + aside +
+          ")");
     }
     int slot = -1;
     while (true) {

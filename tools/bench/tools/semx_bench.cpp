@@ -16,8 +16,9 @@
 #include "semx/bench/bench_plan.hpp"
 #include "semx/bench/bench_scheduler.hpp"
 #include "semx/runtime/args.hpp"
-#include "semx/runtime/lcm_url.hpp"
 #include "semx/runtime/executable_dir.hpp"
+#include "semx/runtime/lcm_url.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 
 using namespace semx;
 namespace fs = std::filesystem;
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
       std::cout << bench::dry_run_text(bench::bench_runs(o));
       return 0;
     }
-    const double t0 = bench::steady_now_s();
+    const double t0 = runtime::monotonic_s();
     std::string out = o.out.empty() ? "runs/bench-" + now_stamp() : o.out;
     std::error_code ec;
     fs::create_directories(out + "/runs", ec);
@@ -85,15 +86,15 @@ int main(int argc, char** argv) {
     so.launch_args = o.launch_args;
     so.base_url = bench::slot_lcm_url(runtime::resolve_lcm_url(""), 0,
                                       o.base_port.empty() ? -1 : std::stoi(o.base_port));
-    std::cout << "semx: bench: slot 1 on " << so.base_url
-              << (jobs > 1 ? " (slot k on its port + k - 1)" : "") << std::endl;
+    std::cout << "semx: bench: slot 1 on " << so.base_url << (jobs > 1 ? " (slot k on its port + k - 1)" : "")
+              << std::endl;
     if (const char* snmp = std::getenv("SEMX_SNMP"); snmp && *snmp) so.snmp_path = snmp;
     if (bench::run_bench(runs, so, std::cout, t0) == 130) {
       std::cout << "semx: bench interrupted; run it again with --out " << out << " to continue" << std::endl;
       return 130;
     }
     std::cout << "semx: bench: " << runs.size() << " runs in "
-              << static_cast<long long>(bench::steady_now_s() - t0) << " s" << std::endl;
+              << static_cast<long long>(runtime::monotonic_s() - t0) << " s" << std::endl;
     std::fflush(stdout);
     const std::string report = runtime::executable_dir() + "/semx-bench-report";
     execl(report.c_str(), report.c_str(), out.c_str(), static_cast<char*>(nullptr));

@@ -17,19 +17,16 @@
 
 #include "semx/core/angles.hpp"
 #include "semx/evaluator/map_picture.hpp"
-#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/runtime/channels.hpp"
+#include "semx/runtime/monotonic_clock.hpp"
 
 namespace semx::evaluator {
 
 namespace ch = semx::channels;
 
 namespace {
-
-double wall_now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 double epoch_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -168,11 +165,12 @@ void EvaluatorNode::open_state() {
         evaluation_.restore(r);
         if (epoch > 0) wall_start_epoch_ = epoch;
       } catch (const std::exception& e) {
-        throw runtime::StateFileError(options_.state_path + ": record " + std::to_string(i + 1) + ": " + e.what());
+        throw runtime::StateFileError(options_.state_path + ": record " + std::to_string(i + 1) + ": " +
+                                      e.what());
       }
     }
     restored_records_ = records.size();
-    if (wall_start_epoch_ > 0) wall_start_ = wall_now() - (epoch_now() - wall_start_epoch_);
+    if (wall_start_epoch_ > 0) wall_start_ = semx::runtime::monotonic_s() - (epoch_now() - wall_start_epoch_);
     saved_samples_ = evaluation_.metrics().samples().size();
   }
   journal_ = std::make_unique<runtime::StateJournal>(options_.state_path, kStateKind, !options_.resume);
@@ -204,14 +202,14 @@ void EvaluatorNode::save_state() {
 
 void EvaluatorNode::note_wall() {
   if (wall_start_ < 0) {
-    wall_start_ = wall_now();
+    wall_start_ = semx::runtime::monotonic_s();
     wall_start_epoch_ = epoch_now();
   }
 }
 
 double EvaluatorNode::wall_s() const {
   if (wall_start_ < 0) return 0.0;
-  return (wall_end_ >= 0 ? wall_end_ : wall_now()) - wall_start_;
+  return (wall_end_ >= 0 ? wall_end_ : semx::runtime::monotonic_s()) - wall_start_;
 }
 
 void EvaluatorNode::on_tick(int64_t /*tick*/, int64_t utime) {
@@ -272,7 +270,7 @@ void EvaluatorNode::check_validity() {
 
 void EvaluatorNode::finish_at(Termination why, int64_t utime) {
   if (finished()) return;
-  wall_end_ = wall_now();
+  wall_end_ = semx::runtime::monotonic_s();
   check_validity();
   evaluation_.finish(why, utime, wall_s());
   write_folder();
@@ -284,9 +282,10 @@ void EvaluatorNode::finish_at(Termination why, int64_t utime) {
       std::printf("semx-evaluator: run folder %s\n", options_.out_dir.c_str());
     }
     if (!s.valid) {
-      std::printf("\033[31msemx-evaluator: this run is NOT VALID: %s. Its figures are not the ones the seed "
-                  "gives; the bench leaves it out of its tables.\033[0m\n",
-                  s.invalid_reason.c_str());
+      std::printf(
+          "\033[31msemx-evaluator: this run is NOT VALID: %s. Its figures are not the ones the seed "
+          "gives; the bench leaves it out of its tables.\033[0m\n",
+          s.invalid_reason.c_str());
     }
     std::fflush(stdout);
   }
@@ -323,7 +322,9 @@ void EvaluatorNode::write_folder() {
         .write_png(png);
     written_.push_back(png);
     const std::string split_png = (std::filesystem::path(options_.out_dir) / "time_split.png").string();
-    time_split_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.time_split, "where the time went: " + title).write_png(split_png);
+    time_split_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.time_split,
+                       "where the time went: " + title)
+        .write_png(split_png);
     written_.push_back(split_png);
     const std::string bt = (std::filesystem::path(options_.out_dir) / "map.bt").string();
     write_octomap_bt(grid, bt);

@@ -1,7 +1,7 @@
 // Runs a bench plan (bench_plan.hpp): each run is `semx-launch demo` (./semx demo's process set) on
-// one of N slots, slot k on the base URL's port + k (LCM_DEFAULT_URL's, else 7667), writing its run folder DIR/runs/NAME; one result
-// line per run from its metrics.csv; runs whose folder has metrics.json are kept; Ctrl-C lets the
-// running sets stop (the terminal's SIGINT reaches their launchers too) and starts no more.
+// one of N slots, slot k on the base URL's port + k (LCM_DEFAULT_URL's, else 7667), writing its run folder
+// DIR/runs/NAME; one result line per run from its metrics.csv; runs whose folder has metrics.json are kept;
+// Ctrl-C lets the running sets stop (the terminal's SIGINT reaches their launchers too) and starts no more.
 #pragma once
 
 #include <cstdint>
@@ -15,9 +15,9 @@
 namespace semx::bench {
 
 struct SchedulerOptions {
-  std::string out_dir;     // DIR: the run folders go to DIR/runs/NAME
-  std::string launcher;    // the semx-launch executable
-  int slots = 1;           // --jobs
+  std::string out_dir;   // DIR: the run folders go to DIR/runs/NAME
+  std::string launcher;  // the semx-launch executable
+  int slots = 1;         // --jobs
   // Slot k's process set talks on this URL with its port + k (slot_lcm_url).
   std::string base_url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
   bool keep_logs = false;  // keep run.lcmlog (and start the set's logger at all)
@@ -57,8 +57,5 @@ std::optional<std::string> result_line(int k, int total, const std::string& name
 // came (the runs already started are waited for), else 0; a SIGINT ignored on entry stays
 // ignored. Elapsed seconds count from `t0_s`, a steady_clock time in seconds.
 int run_bench(const std::vector<BenchRun>& runs, const SchedulerOptions& o, std::ostream& out, double t0_s);
-
-// steady_clock now, in seconds.
-double steady_now_s();
 
 }  // namespace semx::bench
