@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "semx/core/roadmap_values.hpp"
 #include "semx/evaluator/map_picture.hpp"
 #include "semx/evaluator/rgb.hpp"
 #include "semx/map/state_grid.hpp"
@@ -27,29 +28,10 @@
 
 namespace semx::viewer {
 
-struct RoadmapNode {
-  enum Flags : uint8_t { kRoot = 1, kGoal = 2, kOnPath = 4, kFrontier = 8 };
-  int64_t id = 0;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double yaw = 0, gain = 0, reward = 0, cost = 0, score = 0;
-  uint8_t flags = 0;
-};
-
-struct Roadmap {
-  int64_t utime = 0;
-  int64_t iteration = 0;
-  std::vector<RoadmapNode> nodes;
-  std::vector<std::pair<int64_t, int64_t>> edges;  // node ids
-};
-
-struct Region {
-  int64_t id = 0;
-  int class_id = 0;
-  std::string label;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  double weight = 0, radius = 0, confidence = 0, observed_fraction = 0;
-  bool active = true;
-};
+// ROADMAP and SEMANTIC_REGIONS: the values the ROS bridge forwards too.
+using core::Region;
+using core::Roadmap;
+using core::RoadmapNode;
 
 // The controller's trajectory (TRAJECTORY): a uniform B-spline of position control points.
 struct TrajectoryCurve {
