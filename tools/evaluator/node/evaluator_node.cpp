@@ -17,8 +17,8 @@
 
 #include "semx/core/angles.hpp"
 #include "semx/evaluator/map_picture.hpp"
-#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/evaluator/run_folder.hpp"
+#include "semx/evaluator/time_split_picture.hpp"
 #include "semx/runtime/channels.hpp"
 
 namespace semx::evaluator {
@@ -110,6 +110,7 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
       at.emplace(n.id, p);
       r.nodes.push_back(p);
       r.frontier.push_back((n.flags & semx::roadmap_node_t::FRONTIER) != 0);
+      r.gain.push_back(n.gain);
     }
     const size_t edges = std::min(m.edge_from.size(), m.edge_to.size());
     for (size_t i = 0; i < edges; ++i) {
@@ -168,7 +169,8 @@ void EvaluatorNode::open_state() {
         evaluation_.restore(r);
         if (epoch > 0) wall_start_epoch_ = epoch;
       } catch (const std::exception& e) {
-        throw runtime::StateFileError(options_.state_path + ": record " + std::to_string(i + 1) + ": " + e.what());
+        throw runtime::StateFileError(options_.state_path + ": record " + std::to_string(i + 1) + ": " +
+                                      e.what());
       }
     }
     restored_records_ = records.size();
@@ -284,9 +286,10 @@ void EvaluatorNode::finish_at(Termination why, int64_t utime) {
       std::printf("semx-evaluator: run folder %s\n", options_.out_dir.c_str());
     }
     if (!s.valid) {
-      std::printf("\033[31msemx-evaluator: this run is NOT VALID: %s. Its figures are not the ones the seed "
-                  "gives; the bench leaves it out of its tables.\033[0m\n",
-                  s.invalid_reason.c_str());
+      std::printf(
+          "\033[31msemx-evaluator: this run is NOT VALID: %s. Its figures are not the ones the seed "
+          "gives; the bench leaves it out of its tables.\033[0m\n",
+          s.invalid_reason.c_str());
     }
     std::fflush(stdout);
   }
@@ -323,7 +326,9 @@ void EvaluatorNode::write_folder() {
         .write_png(png);
     written_.push_back(png);
     const std::string split_png = (std::filesystem::path(options_.out_dir) / "time_split.png").string();
-    time_split_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.time_split, "where the time went: " + title).write_png(split_png);
+    time_split_picture(grid, evaluation_.world(), &evaluation_.ground_truth(), s.time_split,
+                       "where the time went: " + title)
+        .write_png(split_png);
     written_.push_back(split_png);
     const std::string bt = (std::filesystem::path(options_.out_dir) / "map.bt").string();
     write_octomap_bt(grid, bt);
