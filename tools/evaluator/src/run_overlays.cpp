@@ -61,10 +61,11 @@ void add_roadmap(MapPicture& picture, const RoadmapOverlay& roadmap) {
   for (size_t i = 0; i < roadmap.nodes.size(); ++i)
     (marked[i] ? informative : plain).push_back(roadmap.nodes[i]);
   picture.add_dots(plain, kNode, 1, 0.8);
-  for (const auto& p : informative) picture.add_marker(p, kInformativeNode, "", 3);
+  for (const auto& p : informative) picture.add_marker(p, kInformativeNode, "", 2);
   if (!roadmap.edges.empty()) picture.add_legend("roadmap edges", faded(kEdge, 0.5));
-  if (!roadmap.nodes.empty()) {
+  if (!roadmap.nodes.empty())
     picture.add_legend("roadmap nodes (" + std::to_string(roadmap.nodes.size()) + ")", kNode);
+  if (!informative.empty()) {
     picture.add_legend("informative nodes (gain >= max/4: " + std::to_string(informative.size()) + ")",
                        kInformativeNode);
   }
