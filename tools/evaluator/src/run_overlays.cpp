@@ -61,7 +61,7 @@ void add_roadmap(MapPicture& picture, const RoadmapOverlay& roadmap) {
   for (size_t i = 0; i < roadmap.nodes.size(); ++i)
     (marked[i] ? informative : plain).push_back(roadmap.nodes[i]);
   picture.add_dots(plain, kNode, 1, 0.8);
-  for (const auto& p : informative) picture.add_marker(p, kInformativeNode, "", 2);
+  picture.add_dots(informative, kInformativeNode, 2);
   if (!roadmap.edges.empty()) picture.add_legend("roadmap edges", faded(kEdge, 0.5));
   if (!roadmap.nodes.empty())
     picture.add_legend("roadmap nodes (" + std::to_string(roadmap.nodes.size()) + ")", kNode);

@@ -32,7 +32,7 @@ struct RegionOverlay {
   bool active = true;  // still attracting the planner
 };
 
-// Edges first (thin, faded), then nodes (small grey dots; informative ones orange and larger),
+// Edges first (thin, faded), then nodes (1 px grey dots; informative ones 2 px orange),
 // then regions (faded circles) with their labels placed on top.
 void add_roadmap(MapPicture& picture, const RoadmapOverlay& roadmap);
 void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions);
