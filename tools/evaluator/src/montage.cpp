@@ -57,9 +57,10 @@ Montage render_montage(const std::vector<MontageTile>& tiles, const MontageOptio
     const cv::Mat& p = pictures[static_cast<size_t>(i)];
     if (p.empty()) {
       m(box).setTo(cv::Scalar(225, 225, 225));
-      draw::text_centered(
-          m, "no picture: " + std::filesystem::path(tiles[static_cast<size_t>(i)].png).filename().string(),
-          {x + tw / 2, y + kTitleH + th / 2}, 0.5, cv::Scalar(40, 40, 40));
+      // The run folder's name says whose picture is missing (every tile's file is map.png).
+      const std::filesystem::path f(tiles[static_cast<size_t>(i)].png);
+      draw::text_centered(m, "no picture: " + (f.parent_path().filename() / f.filename()).string(),
+                          {x + tw / 2, y + kTitleH + th / 2}, 0.5, cv::Scalar(40, 40, 40));
     } else {
       // Fit inside the tile, aspect kept, centred; INTER_AREA keeps thin lines from aliasing away.
       const double s = std::min(static_cast<double>(tw) / p.cols, static_cast<double>(th) / p.rows);
