@@ -10,6 +10,8 @@
 
 #include "evaluator_test_util.hpp"
 #include "semx/evaluator/bench_report.hpp"
+#include "semx/evaluator/montage.hpp"
+#include "semx/evaluator/rgb.hpp"
 
 namespace semx::evaluator {
 namespace {
@@ -125,9 +127,10 @@ TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
                           "\"end_game\": {\"time_s\": 20}}}\n";
   const std::string md = bench_markdown(load_bench_runs(root));
   // Differences -10 and -10 s; relative -50 % and -25 %: mean -37.5, sd 17.68, t(1) 12.706.
-  EXPECT_NE(md.find("| generated (2 worlds) | dep | Time_r | 2 | 2 / 0 / 0 | -10.00 | [-10.00, -10.00] | -37.5 | "
-                    "[-196.3, 121.3] |"),
-            std::string::npos)
+  EXPECT_NE(
+      md.find("| generated (2 worlds) | dep | Time_r | 2 | 2 / 0 / 0 | -10.00 | [-10.00, -10.00] | -37.5 | "
+              "[-196.3, 121.3] |"),
+      std::string::npos)
       << md;
   EXPECT_NE(md.find("| generated-s1-a50-r1 | dep | 1 | 40.0 | 30.0 | 10.0 | 0.0 | 20.0 | 100.0 | 7.5 |"),
             std::string::npos)
@@ -182,10 +185,12 @@ TEST(BenchReport, DisturbedRunsAreListedUnderTheTablesNotInThem) {
   EXPECT_EQ(runs[2].restarts, "mapper 12.5 s");
   const std::string md = bench_markdown(runs);
   EXPECT_NE(md.find("| env1 | semantic-dep | 2 | 100.00 ± 0.00 |"), std::string::npos)
-      << "the table has the two undisturbed seeds:\n" << md;
+      << "the table has the two undisturbed seeds:\n"
+      << md;
   const auto listed = md.find("### Disturbed runs");
   ASSERT_NE(listed, std::string::npos) << md;
-  EXPECT_NE(md.find("| env1 | semantic-dep | 45 | 3 | mapper 12.5 s | 300.00 |", listed), std::string::npos) << md;
+  EXPECT_NE(md.find("| env1 | semantic-dep | 45 | 3 | mapper 12.5 s | 300.00 |", listed), std::string::npos)
+      << md;
   EXPECT_NE(bench_csv(runs).find(",true\n"), std::string::npos) << "the CSV keeps every run, marked";
 }
 
@@ -209,6 +214,92 @@ TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {
     EXPECT_NE(std::string(e.what()).find("metrics.json: 'time_f_s' is not a number"), std::string::npos)
         << e.what();
   }
+}
+
+TEST(BenchReport, TheSpreadOverSeedsIsTheMinimumAndMaximumOfTheCurves) {
+  const std::vector<std::vector<std::pair<double, double>>> curves = {
+      {{0, 0}, {1, 10}, {2, 40}, {3, 80}},  // ends at 3 s and holds 80
+      {{0, 0}, {1.5, 30}, {4, 60}},
+      {{0.5, 5}, {2, 20}, {5, 90}}};  // nothing before 0.5 s: 0
+  const SeedSpread s = spread_over_seeds(curves, 5.0, 1.0);
+  ASSERT_EQ(s.t.size(), 6u);
+  // Held values per step: t=0 {0,0,0}, 1 {10,0,5}, 2 {40,30,20}, 3 {80,30,20}, 4 {80,60,20}, 5 {80,60,90}.
+  const double lo[] = {0, 0, 20, 20, 20, 60}, hi[] = {0, 10, 40, 80, 80, 90},
+               mean[] = {0, 5, 30, 130.0 / 3, 160.0 / 3, 230.0 / 3};
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_DOUBLE_EQ(s.t[i], static_cast<double>(i));
+    EXPECT_DOUBLE_EQ(s.lo[i], lo[i]) << i;
+    EXPECT_DOUBLE_EQ(s.hi[i], hi[i]) << i;
+    EXPECT_NEAR(s.mean[i], mean[i], 1e-9) << i;
+  }
+  EXPECT_TRUE(spread_over_seeds({}, 5.0).t.empty());
+}
+
+TEST(BenchReport, TheMedianCoverageRunIsTheMiddleSeed) {
+  BenchRun a, b, c, d;
+  a.seed = 1, a.coverage_pct = 90;
+  b.seed = 2, b.coverage_pct = 70;
+  c.seed = 3, c.coverage_pct = 80;
+  d.seed = 4, d.coverage_pct = 95;
+  EXPECT_EQ(median_coverage_run({&a, &b, &c}), &c);
+  EXPECT_EQ(median_coverage_run({&a, &b, &c, &d}), &c);  // the lower middle of four
+  EXPECT_EQ(median_coverage_run({&d}), &d);
+  EXPECT_EQ(median_coverage_run({}), nullptr);
+}
+
+void write_picture(const std::string& path, int w, int h, Rgb fill) { write_png(Image(w, h, fill), path); }
+
+TEST(BenchReport, MontageTilesEveryPictureAndReportsAMissingOne) {
+  const std::string dir = test::temp_dir("montage");
+  fs::create_directories(dir);
+  write_picture(dir + "/a.png", 800, 400, {250, 0, 0});
+  write_picture(dir + "/b.png", 400, 400, {0, 0, 250});
+  { std::ofstream(dir + "/broken.png") << "not a png"; }
+  MontageOptions o;
+  o.tile_width = 200;
+  o.columns = 2;
+  const Montage m = render_montage(
+      {{dir + "/a.png", "a"}, {dir + "/b.png", "b"}, {dir + "/none.png", "c"}, {dir + "/broken.png", "d"}},
+      o);
+  ASSERT_EQ(m.missing.size(), 2u);
+  EXPECT_NE(m.missing[0].find("none.png: no such file"), std::string::npos);
+  EXPECT_NE(m.missing[1].find("broken.png: not a readable picture"), std::string::npos);
+  // Two columns of 200 px tiles, two rows; tiles 100 px high (the first picture's aspect).
+  EXPECT_GT(m.image.width, 400);
+  EXPECT_LT(m.image.width, 460);
+  EXPECT_GT(m.image.height, 200);
+  EXPECT_LT(m.image.height, 320);
+  int red = 0, blue = 0;
+  for (int y = 0; y < m.image.height; ++y)
+    for (int x = 0; x < m.image.width; ++x) {
+      const Rgb p = m.image.at(x, y);
+      red += p.r > 230 && p.g < 20 && p.b < 20;
+      blue += p.b > 230 && p.r < 20 && p.g < 20;
+    }
+  EXPECT_GT(red, 190 * 90);  // a scaled to 200 x 100
+  EXPECT_GT(blue, 95 * 95);  // b fitted into 100 x 100
+  EXPECT_LT(blue, 105 * 105);
+}
+
+TEST(BenchReport, MapMontageAndBandsFromRunFolders) {
+  const std::string root = test::temp_dir("bench_maps");
+  write_run(root, "env1", "dep", 1, 100, 10, 30);
+  write_run(root, "env1", "dep", 2, 120, 20, 50);
+  write_run(root, "env1", "fuel", 1, 90, 15, 40);
+  write_picture(root + "/env1-dep-s45-seed1/map.png", 300, 200, {10, 200, 10});
+  write_picture(root + "/env1-dep-s45-seed2/map.png", 300, 200, {10, 200, 10});
+  // fuel's run folder has no map.png.
+  const auto runs = load_bench_runs(root);
+  std::vector<std::string> missing;
+  const auto maps = write_bench_montages(runs, root, {}, &missing);
+  ASSERT_EQ(maps.size(), 1u);
+  EXPECT_EQ(fs::path(maps[0]).filename(), "maps_env1.png");
+  EXPECT_GT(fs::file_size(maps[0]), 1000u);
+  ASSERT_EQ(missing.size(), 1u);
+  EXPECT_NE(missing[0].find("env1-fuel-s45-seed1/map.png"), std::string::npos);
+  const auto plots = write_bench_plots(runs, root);
+  ASSERT_EQ(plots.size(), 1u);
+  EXPECT_TRUE(fs::exists(root + "/coverage_env1.png"));
 }
 
 }  // namespace

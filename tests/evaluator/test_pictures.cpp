@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 
 #include "evaluator_test_util.hpp"
 #include "semx/evaluator/coverage_plot.hpp"
 #include "semx/evaluator/map_picture.hpp"
+#include "semx/evaluator/run_overlays.hpp"
 
 namespace semx::evaluator {
 namespace {
@@ -115,8 +117,77 @@ TEST(MapPicture, RunPictureDrawsTheTrajectory) {
   const std::vector<Eigen::Vector3d> traj = {{0.5, 0.5, 1}, {1.5, 0.6, 1}, {2.5, 2.0, 1}};
   MapPicture pic = run_map_picture(grid, world, &gt, traj, "small");
   const Image img = pic.render();
-  EXPECT_GT(count_pixels(img, {30, 90, 220}), 30);  // the trajectory's colour
+  EXPECT_GT(count_pixels(img, kTrajectoryColour), 30);
   EXPECT_GT(pic.count(MapPicture::Column::kUnmappedWall), 100);
+}
+
+TEST(MapPicture, OverlaysAndLabelsStayInsideTheMapFrame) {
+  map::StateGrid grid(0.1);
+  grid.set_state({5, 5, 10}, map::VoxelState::kFree);
+  MapPictureOptions o;
+  o.max_side_px = 300;
+  MapView v;
+  v.lo = {0, 0};
+  v.hi = {4, 3};
+  const Image bare = MapPicture(grid, v, o).render();
+  MapPicture pic(grid, v, o);
+  const Rgb c{200, 0, 160};
+  // A region far larger than the map, one whose centre lies outside it, a long label at the
+  // corner, roadmap edges running off every side, a marker on the edge.
+  pic.add_circle({2, 1.5}, 30, c, "a region larger than the map", true, 3);
+  pic.add_circle({-0.5, 3.2}, 1.0, c, "outside", false, 2, 0.6);
+  pic.add_segments({{{-5, -5}, {9, 8}}, {{-3, 1}, {9, 1}}}, {0, 0, 0}, 2, 0.5);
+  pic.add_marker({4, 3}, {220, 30, 30}, "a marker label on the corner of the map", 6);
+  pic.add_text({3.9, 0.1}, "text at the edge", c);
+  const Image img = pic.render();
+  ASSERT_EQ(img.width, bare.width);
+  ASSERT_EQ(img.height, bare.height);
+  const int m = o.margin_px, w = pic.columns_x() * pic.pixels_per_column(),
+            h = pic.columns_y() * pic.pixels_per_column();
+  int outside_changed = 0, inside_changed = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const bool inside = x >= m && x < m + w && y >= m && y < m + h;
+      if (img.at(x, y) != bare.at(x, y)) ++(inside ? inside_changed : outside_changed);
+    }
+  EXPECT_EQ(outside_changed, 0);         // the frame, title, scale bar and legend untouched
+  EXPECT_GT(inside_changed, w * h / 2);  // the big region's fill covers the map
+}
+
+TEST(MapPicture, InformativeNodesAreFrontierNodesOfHighGain) {
+  RoadmapOverlay r;
+  r.nodes = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}};
+  r.frontier = {false, true, true, true, true};
+  r.gain = {100, 40, 9, 10, std::numeric_limits<double>::quiet_NaN()};
+  // Node 0 has the highest gain but is no frontier node; the bar is a quarter of 100.
+  EXPECT_EQ(informative_nodes(r), (std::vector<size_t>{1}));
+  r.gain[0] = 0;
+  r.gain[1] = 36;  // the highest now: the bar drops to 9
+  EXPECT_EQ(informative_nodes(r), (std::vector<size_t>{1, 2, 3}));
+  r.gain.clear();  // no gains: every frontier node
+  EXPECT_EQ(informative_nodes(r), (std::vector<size_t>{1, 2, 3, 4}));
+}
+
+TEST(MapPicture, FadedSegmentsBlendWithTheMapBeneath) {
+  map::StateGrid grid(0.1);
+  for (int x = 0; x < 40; ++x)
+    for (int y = 0; y < 30; ++y) grid.set_state({x, y, 10}, map::VoxelState::kFree);
+  MapPictureOptions o;
+  o.pixels_per_column = 5;
+  MapView v;
+  v.hi = {4, 3};
+  MapPicture pic(grid, v, o);
+  const Rgb black{0, 0, 0};
+  pic.add_segments({{{0, 1.5}, {4, 1.5}}}, black, 3, 0.25);
+  pic.add_dots({{2, 0.5}}, black, 3, 1.0);
+  const Image img = pic.render();
+  const Eigen::Vector2i on = pic.pixel({1, 1.5});
+  const Rgb got = img.at(on.x(), on.y());
+  // A quarter of black over the free colour: darker than free, far from black.
+  EXPECT_NEAR(got.r, 0.75 * o.free.r, 4);
+  EXPECT_NEAR(got.g, 0.75 * o.free.g, 4);
+  const Eigen::Vector2i dot = pic.pixel({2, 0.5});
+  EXPECT_EQ(img.at(dot.x(), dot.y()), black);  // an opaque dot
 }
 
 }  // namespace

@@ -18,8 +18,8 @@ namespace {
 
 // "oracle" is the known-map reference (it reads the world's ground truth); the report divides
 // the others' times by its own.
-const std::vector<std::string> kPlanners = {"semantic-dep", "dep", "nbv", "aep", "fuel", "oracle", "semantic-room",
-                                            "semantic-fuel"};
+const std::vector<std::string> kPlanners = {"semantic-dep", "dep",    "nbv",           "aep",
+                                            "fuel",         "oracle", "semantic-room", "semantic-fuel"};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -162,7 +162,8 @@ void validate_bench_options(const BenchOptions& o) {
   if (!o.base_port.empty() &&
       (!positive_integer(o.base_port) || o.base_port.size() > 5 || std::stoi(o.base_port) < 1024 ||
        std::stoi(o.base_port) + std::stoi(o.jobs) - 1 > 65535)) {
-    throw ArgError("--base-port '" + o.base_port + "': expected a port from 1024 with --jobs ports free above it");
+    throw ArgError("--base-port '" + o.base_port +
+                   "': expected a port from 1024 with --jobs ports free above it");
   }
   for (const auto& p : list_words(o.planners)) {
     if (std::find(kPlanners.begin(), kPlanners.end(), p) == kPlanners.end()) {
@@ -318,8 +319,9 @@ DIR/runs/ (default DIR: runs/bench-DATE); a run whose folder already has the met
 that ended (DONE, time limit) is not run again, so an interrupted bench continues where it
 stopped; one that was stopped before its end runs again, its old folder moved to
 DIR/interrupted/ (not in the tables). At the end semx-bench-report
-writes DIR/tables.md (mean ± std over seeds, the paper's layout), DIR/results.csv and
-DIR/coverage_WORLD.png (every planner on one plot per world).
+writes DIR/tables.md (mean ± std over seeds, the paper's layout), DIR/results.csv,
+DIR/coverage_WORLD.png (every planner on one plot per world, min-max bands over seeds) and
+DIR/maps_WORLD.png (each planner's map.png, the seed of median coverage).
 --worlds generated: eight generated apartments of 50 to 600 m² and 1 to 14 rooms (semx-world gen,
 seeds 1-8, written to DIR/worlds/), time limits 300 s + 2 s per m² unless --time-limits names them.
 Time limits (simulated s): env1=300, env2=600, env3=900 by default. --logs keeps each run's

@@ -30,8 +30,9 @@ int main(int argc, char** argv) {
         "semx-bench-report",
         "Summarises every run folder under DIR (metrics.json, coverage.csv) as the paper's\n"
         "tables (mean ± std over seeds): the sampling-density sweep, the planner comparison and\n"
-        "the margins of semantic-dep over each baseline; writes DIR/tables.md, DIR/results.csv\n"
-        "and DIR/coverage_WORLD.png, and prints the tables.");
+        "the margins of semantic-dep over each baseline; writes DIR/tables.md, DIR/results.csv,\n"
+        "DIR/coverage_WORLD.png (mean curves, min-max bands over seeds) and DIR/maps_WORLD.png\n"
+        "(each planner's map.png, the seed of median coverage), and prints the tables.");
     p.positional("DIR", "a ./semx bench output folder (run folders anywhere below it)", &root)
         .option("out", "DIR", "where to write the report (default: DIR)", &out)
         .option("sweep-planner", "NAME", "the planner of the sampling-density table (default semantic-dep)",
@@ -51,7 +52,10 @@ int main(int argc, char** argv) {
     const std::string md = evaluator::bench_markdown(runs, o);
     write_text((std::filesystem::path(out) / "tables.md").string(), md);
     write_text((std::filesystem::path(out) / "results.csv").string(), evaluator::bench_csv(runs));
-    const auto plots = evaluator::write_bench_plots(runs, out, o);
+    auto plots = evaluator::write_bench_plots(runs, out, o);
+    std::vector<std::string> missing;
+    for (const auto& f : evaluator::write_bench_montages(runs, out, o, &missing)) plots.push_back(f);
+    for (const auto& m : missing) std::cerr << "semx-bench-report: map montage without " << m << "\n";
     std::cout << md << "\nsemx-bench-report: " << out << "/tables.md, results.csv";
     for (const auto& f : plots) std::cout << ", " << std::filesystem::path(f).filename().string();
     std::cout << "\n";

@@ -107,6 +107,7 @@ EvaluatorNode::EvaluatorNode(runtime::Node& node, simulator::World world, Evalua
       at.emplace(n.id, p);
       r.nodes.push_back(p);
       r.frontier.push_back((n.flags & semx::roadmap_node_t::FRONTIER) != 0);
+      r.gain.push_back(n.gain);
     }
     const size_t edges = std::min(m.edge_from.size(), m.edge_to.size());
     for (size_t i = 0; i < edges; ++i) {

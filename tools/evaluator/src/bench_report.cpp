@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "semx/evaluator/coverage_plot.hpp"
+#include "semx/evaluator/montage.hpp"
 
 namespace semx::evaluator {
 
@@ -21,8 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // The paper's rows, then the references: the FUEL-class baseline and the known-map oracle.
-const std::vector<std::string> kPlannerOrder = {"nbv", "aep", "dep", "semantic-dep", "semantic-room", "fuel",
-                                                 "semantic-fuel", "oracle"};
+const std::vector<std::string> kPlannerOrder = {"nbv",           "aep",  "dep",           "semantic-dep",
+                                                "semantic-room", "fuel", "semantic-fuel", "oracle"};
 // The planner every other row is divided by in the "× oracle" table.
 const char* const kOraclePlanner = "oracle";
 
@@ -229,7 +230,8 @@ BenchRun load_bench_run(const std::string& dir) {
   if (m["restarts"] && m["restarts"].IsSequence()) {
     for (const auto& x : m["restarts"]) {
       if (!x.IsMap() || !x["node"] || !x["t_s"]) continue;
-      r.restarts += (r.restarts.empty() ? "" : ", ") + x["node"].as<std::string>() + " " + x["t_s"].as<std::string>() + " s";
+      r.restarts += (r.restarts.empty() ? "" : ", ") + x["node"].as<std::string>() + " " +
+                    x["t_s"].as<std::string>() + " s";
     }
   }
 
@@ -313,8 +315,8 @@ std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOp
   std::string left_out;
   for (const auto& r : all) {
     if (r.valid || r.disturbed) continue;  // a disturbed run is listed with the disturbed ones
-    left_out += "- " + r.dir + " (" + r.world + ", " + r.planner + ", seed " + std::to_string(r.seed) + "): " +
-                r.invalid_reason + "\n";
+    left_out += "- " + r.dir + " (" + r.world + ", " + r.planner + ", seed " + std::to_string(r.seed) +
+                "): " + r.invalid_reason + "\n";
   }
   if (!left_out.empty()) {
     md += "\n### Runs left out of the tables (not valid: lost or mixed messages)\n\n" + left_out;
@@ -323,14 +325,16 @@ std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOp
   for (const auto& r : all) {
     if (!r.disturbed) continue;
     d << "| " << r.world << " | " << r.planner << " | " << r.samples << " | " << r.seed << " | "
-      << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | " << fmt(r.coverage_pct, 2)
-      << " | " << r.termination << " | " << (r.valid ? "" : r.invalid_reason) << " | " << r.dir << " |\n";
+      << (r.restarts.empty() ? "?" : r.restarts) << " | " << fmt(r.time_f_s, 2) << " | "
+      << fmt(r.coverage_pct, 2) << " | " << r.termination << " | " << (r.valid ? "" : r.invalid_reason)
+      << " | " << r.dir << " |\n";
   }
   if (!d.str().empty()) {
-    md += "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
-          "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
-          "termination | not valid | folder |\n|---|---|---|---|---|---|---|---|---|---|\n" +
-          d.str();
+    md +=
+        "\n### Disturbed runs (a process died and was restarted): not in the tables\n\n"
+        "| Env. | Algorithm | no. S. | seed | restarted (simulated time) | Time_f (s) | Coverage (%) | "
+        "termination | not valid | folder |\n|---|---|---|---|---|---|---|---|---|---|\n" +
+        d.str();
   }
   return md;
 }
@@ -454,22 +458,22 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
   // The generated worlds pooled: each run paired with the baseline's of the same world and seed.
   std::map<std::string, std::pair<Group, Group>> pooled;
   std::set<std::string> pooled_worlds;
-  for_each_baseline(runs, o,
-                    [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
-                      for (const auto& [name, field] : times)
-                        md << "| " << w << " | " << p << " | " << name << " | "
-                           << paired_row(ours, theirs, field) << "\n";
-                      if (!is_generated(w)) return;
-                      pooled_worlds.insert(w);
-                      auto& [po, pt] = pooled[p];
-                      po.runs.insert(po.runs.end(), ours.runs.begin(), ours.runs.end());
-                      pt.runs.insert(pt.runs.end(), theirs.runs.begin(), theirs.runs.end());
-                    });
+  for_each_baseline(
+      runs, o, [&](const std::string& w, const std::string& p, const Group& ours, const Group& theirs) {
+        for (const auto& [name, field] : times)
+          md << "| " << w << " | " << p << " | " << name << " | " << paired_row(ours, theirs, field) << "\n";
+        if (!is_generated(w)) return;
+        pooled_worlds.insert(w);
+        auto& [po, pt] = pooled[p];
+        po.runs.insert(po.runs.end(), ours.runs.begin(), ours.runs.end());
+        pt.runs.insert(pt.runs.end(), theirs.runs.begin(), theirs.runs.end());
+      });
   for (const auto& [p, groups] : pooled) {
-    const std::string w = std::string(kGeneratedPrefix) + " (" + std::to_string(pooled_worlds.size()) + " worlds)";
+    const std::string w =
+        std::string(kGeneratedPrefix) + " (" + std::to_string(pooled_worlds.size()) + " worlds)";
     for (const auto& [name, field] : times)
-      md << "| " << w << " | " << p << " | " << name << " | " << paired_row(groups.first, groups.second, field)
-         << "\n";
+      md << "| " << w << " | " << p << " | " << name << " | "
+         << paired_row(groups.first, groups.second, field) << "\n";
   }
 
   // Where the time went (time_split.json; core/time_split.hpp), mean seconds per run.
@@ -480,7 +484,8 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
        << "new: flying while the map grows ≥ 0.25 m³/s; revisit: flying while it grows less (through mapped "
           "space); turn: turning in place; hover: neither; end game: after the map settled. By place: metres "
           "flown within 1 m of where the vehicle was 10 s or more before.\n\n"
-       << "| Env. | Algorithm | runs | new | revisit | turn | hover | end game | Time_f | revisit by place (m) |\n"
+       << "| Env. | Algorithm | runs | new | revisit | turn | hover | end game | Time_f | revisit by place "
+          "(m) |\n"
        << "|---|---|---|---|---|---|---|---|---|---|\n";
     auto split_row = [&](const std::string& w, const std::string& p, const std::vector<const BenchRun*>& g) {
       std::vector<std::vector<double>> v(5);
@@ -512,7 +517,8 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
       }
     }
     for (const auto& [p, g] : generated)
-      split_row(std::string(kGeneratedPrefix) + " (" + std::to_string(generated_worlds.size()) + " worlds)", p, g);
+      split_row(std::string(kGeneratedPrefix) + " (" + std::to_string(generated_worlds.size()) + " worlds)",
+                p, g);
   }
   double wall = 0, sim = 0;
   for (const auto& r : runs) {
@@ -544,6 +550,31 @@ std::string bench_csv(const std::vector<BenchRun>& runs) {
   return c.str();
 }
 
+SeedSpread spread_over_seeds(const std::vector<std::vector<std::pair<double, double>>>& curves,
+                             double t_max_s, double step_s) {
+  SeedSpread out;
+  if (curves.empty() || !(step_s > 0) || !(t_max_s >= 0) || !std::isfinite(t_max_s)) return out;
+  std::vector<size_t> next(curves.size(), 0);  // per curve: its first sample after t
+  std::vector<double> held(curves.size(), 0.0);
+  const auto steps = static_cast<int64_t>(std::floor(t_max_s / step_s + 1e-9));
+  for (int64_t k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * step_s;
+    double sum = 0, lo = 0, hi = 0;
+    for (size_t i = 0; i < curves.size(); ++i) {
+      const auto& c = curves[i];
+      while (next[i] < c.size() && c[next[i]].first <= t + 1e-9) held[i] = c[next[i]++].second;
+      sum += held[i];
+      lo = i == 0 ? held[i] : std::min(lo, held[i]);
+      hi = i == 0 ? held[i] : std::max(hi, held[i]);
+    }
+    out.t.push_back(t);
+    out.mean.push_back(sum / static_cast<double>(curves.size()));
+    out.lo.push_back(lo);
+    out.hi.push_back(hi);
+  }
+  return out;
+}
+
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, const std::string& dir,
                                            const BenchReportOptions& o) {
   const std::vector<BenchRun> runs = tabled_only(all);
@@ -558,20 +589,15 @@ std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, con
     for (const auto* r : here) t_max = std::max(t_max, r->coverage.empty() ? 0.0 : r->coverage.back().first);
     for (const auto& p : planners_of(here)) {
       const Group g = select(runs, w, p, o.comparison_samples);
-      // The mean over seeds at 1 s steps; a run that ended holds its final coverage.
+      std::vector<std::vector<std::pair<double, double>>> curves;
+      for (const auto* r : g.runs) curves.push_back(r->coverage);
+      const SeedSpread spread = spread_over_seeds(curves, t_max, 1.0);
       PlotSeries s;
-      s.label = p + " (" + std::to_string(g.runs.size()) + (g.runs.size() == 1 ? " seed)" : " seeds)");
-      for (double t = 0; t <= t_max + 1e-9; t += 1.0) {
-        double sum = 0;
-        for (const auto* r : g.runs) {
-          double v = 0;
-          for (const auto& [ts, c] : r->coverage) {
-            if (ts > t + 1e-9) break;
-            v = c;
-          }
-          sum += v;
-        }
-        s.points.emplace_back(t, sum / static_cast<double>(g.runs.size()));
+      const size_t n = g.runs.size();
+      s.label = p + " (" + std::to_string(n) + (n == 1 ? " seed)" : " seeds, mean; band: min-max)");
+      for (size_t i = 0; i < spread.t.size(); ++i) {
+        s.points.emplace_back(spread.t[i], spread.mean[i]);
+        if (n > 1) s.band.push_back({spread.t[i], spread.lo[i], spread.hi[i]});
       }
       series.push_back(std::move(s));
     }
@@ -581,6 +607,46 @@ std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, con
     po.threshold_pct = o.threshold_pct;
     const std::string file = (fs::path(dir) / ("coverage_" + w + ".png")).string();
     write_coverage_plot(file, series, po);
+    written.push_back(file);
+  }
+  return written;
+}
+
+const BenchRun* median_coverage_run(std::vector<const BenchRun*> runs) {
+  if (runs.empty()) return nullptr;
+  std::sort(runs.begin(), runs.end(), [](const BenchRun* a, const BenchRun* b) {
+    return a->coverage_pct != b->coverage_pct ? a->coverage_pct < b->coverage_pct : a->seed < b->seed;
+  });
+  return runs[(runs.size() - 1) / 2];
+}
+
+std::vector<std::string> write_bench_montages(const std::vector<BenchRun>& all, const std::string& dir,
+                                              const BenchReportOptions& o,
+                                              std::vector<std::string>* missing) {
+  const std::vector<BenchRun> runs = tabled_only(all);
+  std::vector<std::string> written;
+  for (const auto& w : worlds_of(runs)) {
+    std::vector<const BenchRun*> here;
+    for (const auto& r : runs)
+      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    if (here.empty()) continue;
+    std::vector<MontageTile> tiles;
+    for (const auto& p : planners_of(here)) {
+      const Group g = select(runs, w, p, o.comparison_samples);
+      const BenchRun* r = median_coverage_run(g.runs);
+      std::string title = p + ", seed " + std::to_string(r->seed);
+      if (g.runs.size() > 1) title += " (median of " + std::to_string(g.runs.size()) + ")";
+      title += ": " + fmt(r->coverage_pct, 1) + " %, Time_95 " +
+               (r->time_95_s ? fmt(*r->time_95_s, 1) + " s" : std::string("not reached"));
+      tiles.push_back({(fs::path(r->dir) / "map.png").string(), title});
+    }
+    MontageOptions mo;
+    mo.title = w + ": each planner's map.png at " + std::to_string(o.comparison_samples) +
+               " samples (the seed of median coverage)";
+    const Montage m = render_montage(tiles, mo);
+    if (missing) missing->insert(missing->end(), m.missing.begin(), m.missing.end());
+    const std::string file = (fs::path(dir) / ("maps_" + w + ".png")).string();
+    write_png(m.image, file);
     written.push_back(file);
   }
   return written;

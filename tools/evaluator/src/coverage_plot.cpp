@@ -92,6 +92,26 @@ Image render_coverage_plot(const std::vector<PlotSeries>& series, const Coverage
     std::snprintf(b, sizeof b, "%g %%", o.threshold_pct);
     draw::text_right(m, b, {x1 - 4, y - 6}, 0.45, cv::Scalar(40, 40, 200));
   }
+  // Bands first, each blended on its own so that overlapping bands stay visible, under every curve.
+  for (size_t i = 0; i < series.size(); ++i) {
+    const auto& s = series[i];
+    std::vector<cv::Point> poly;
+    for (const auto& b : s.band) {
+      if (std::isfinite(b.t) && std::isfinite(b.hi))
+        poly.emplace_back(static_cast<int>(std::lround(px(b.t))), static_cast<int>(std::lround(py(b.hi))));
+    }
+    for (auto it = s.band.rbegin(); it != s.band.rend(); ++it) {
+      if (std::isfinite(it->t) && std::isfinite(it->lo))
+        poly.emplace_back(static_cast<int>(std::lround(px(it->t))),
+                          static_cast<int>(std::lround(py(it->lo))));
+    }
+    if (poly.size() < 3) continue;
+    Rgb c = s.color;
+    if (c == Rgb{0, 0, 0}) c = palette(static_cast<int>(i));
+    cv::Mat layer = m.clone();
+    cv::fillPoly(layer, std::vector<std::vector<cv::Point>>{poly}, draw::bgr(c), cv::LINE_AA);
+    cv::addWeighted(layer, 0.2, m, 0.8, 0, m);
+  }
   // Series.
   for (size_t i = 0; i < series.size(); ++i) {
     const auto& s = series[i];

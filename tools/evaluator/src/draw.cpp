@@ -44,6 +44,13 @@ void text_vertical(cv::Mat& m, const std::string& s, cv::Point center, double sc
   r(cv::Rect(clipped.x - dst.x, clipped.y - dst.y, clipped.width, clipped.height)).copyTo(m(clipped));
 }
 
+cv::Size text_size(const std::string& s, double scale, int thickness, int* baseline) {
+  int base = 0;
+  const cv::Size sz = cv::getTextSize(s, kFont, scale, thickness, &base);
+  if (baseline) *baseline = base;
+  return sz;
+}
+
 void dashed_line(cv::Mat& m, cv::Point a, cv::Point b, cv::Scalar color, int thickness, int dash, int gap) {
   const double len = std::hypot(b.x - a.x, b.y - a.y);
   if (len <= 0) return;
@@ -56,15 +63,25 @@ void dashed_line(cv::Mat& m, cv::Point a, cv::Point b, cv::Scalar color, int thi
   }
 }
 
+namespace {
+constexpr double kLegendScale = 0.45;
+constexpr int kLegendLine = 18, kSwatch = 22, kLegendPad = 6;
+}  // namespace
+
+cv::Size legend_size(const std::vector<std::pair<std::string, Rgb>>& entries) {
+  if (entries.empty()) return {0, 0};
+  int w = 0, base = 0;
+  for (const auto& e : entries)
+    w = std::max(w, cv::getTextSize(e.first, kFont, kLegendScale, 1, &base).width);
+  return {kLegendPad + kSwatch + 6 + w + kLegendPad,
+          kLegendPad + kLegendLine * static_cast<int>(entries.size()) + kLegendPad / 2};
+}
+
 void legend(cv::Mat& m, const std::vector<std::pair<std::string, Rgb>>& entries, cv::Point anchor,
             Corner corner) {
   if (entries.empty()) return;
-  const double scale = 0.45;
-  int w = 0, base = 0;
-  for (const auto& e : entries) w = std::max(w, cv::getTextSize(e.first, kFont, scale, 1, &base).width);
-  const int line_h = 18, swatch = 22, pad = 6;
-  const int bw = pad + swatch + 6 + w + pad;
-  const int bh = pad + line_h * static_cast<int>(entries.size()) + pad / 2;
+  const cv::Size size = legend_size(entries);
+  const int bw = size.width, bh = size.height, pad = kLegendPad, line_h = kLegendLine, swatch = kSwatch;
   int x = anchor.x, y = anchor.y;
   if (corner == Corner::kTopRight || corner == Corner::kBottomRight) x -= bw;
   if (corner == Corner::kBottomLeft || corner == Corner::kBottomRight) y -= bh;
@@ -74,7 +91,7 @@ void legend(cv::Mat& m, const std::vector<std::pair<std::string, Rgb>>& entries,
     const int cy = y + pad + line_h * static_cast<int>(i) + line_h / 2;
     cv::rectangle(m, {x + pad, cy - 4}, {x + pad + swatch, cy + 4}, bgr(entries[i].second), cv::FILLED);
     cv::rectangle(m, {x + pad, cy - 4}, {x + pad + swatch, cy + 4}, cv::Scalar(90, 90, 90), 1);
-    text_left(m, entries[i].first, {x + pad + swatch + 6, cy + 5}, scale, cv::Scalar(30, 30, 30));
+    text_left(m, entries[i].first, {x + pad + swatch + 6, cy + 5}, kLegendScale, cv::Scalar(30, 30, 30));
   }
 }
 

@@ -18,8 +18,8 @@ struct BenchRun {
   int64_t seed = 0;
   int samples = 0;
   double time_f_s = 0, distance_m = 0, coverage_pct = 0, wall_s = 0, sim_s = 0;
-  std::optional<double> time_r_s;  // never reached 85 %
-  std::optional<double> time_o_s;  // objects never 75 % covered, or a run folder from before it
+  std::optional<double> time_r_s;        // never reached 85 %
+  std::optional<double> time_o_s;        // objects never 75 % covered, or a run folder from before it
   std::optional<double> time_95_s;       // never reached 95 %, or a run folder from before it
   std::optional<double> time_settled_s;  // coverage within 0.5 points of its final value
   std::optional<double> end_game_s;      // time_f_s - time_settled_s
@@ -67,9 +67,31 @@ inline constexpr const char* kGeneratedPrefix = "generated";
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
 // One row per run (the columns of metrics.csv plus the folder).
 std::string bench_csv(const std::vector<BenchRun>& runs);
-// DIR/coverage_WORLD.png per world (undisturbed runs): the mean coverage curve over seeds of every planner at the
-// comparison density. Returns the files written.
+// Coverage curves of several runs ((t s, %), t increasing) at 0, step_s, ... up to t_max_s:
+// their mean, minimum and maximum at each step; a run that ended holds its final coverage, and
+// before its first sample it counts as 0.
+struct SeedSpread {
+  std::vector<double> t, mean, lo, hi;
+};
+SeedSpread spread_over_seeds(const std::vector<std::vector<std::pair<double, double>>>& curves,
+                             double t_max_s, double step_s = 1.0);
+
+// DIR/coverage_WORLD.png per world (valid, undisturbed runs): every planner's mean coverage
+// curve over seeds at the comparison density, with a shaded band from the lowest to the highest
+// seed's curve where it has more than one seed. Returns the files written.
 std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& runs, const std::string& dir,
                                            const BenchReportOptions& options = {});
+
+// The run whose map a planner's montage tile shows: of its seeds, the one with the median final
+// coverage (the lower of the two middle ones for an even count; ties by seed).
+const BenchRun* median_coverage_run(std::vector<const BenchRun*> runs);
+
+// DIR/maps_WORLD.png per world (the same runs): a grid of one map.png per planner
+// (median_coverage_run), each titled with the planner, the seed, its coverage and Time_95.
+// Run folders without a readable map.png get a grey tile and are listed in *missing ("FILE:
+// why"). Returns the files written.
+std::vector<std::string> write_bench_montages(const std::vector<BenchRun>& runs, const std::string& dir,
+                                              const BenchReportOptions& options = {},
+                                              std::vector<std::string>* missing = nullptr);
 
 }  // namespace semx::evaluator

@@ -12,11 +12,17 @@
 
 namespace semx::evaluator {
 
+// A shaded band around a series (the spread over seeds): at time t, from lo to hi percent.
+struct BandPoint {
+  double t = 0, lo = 0, hi = 0;
+};
+
 struct PlotSeries {
   std::string label;                              // legend text ("" for none)
   std::vector<std::pair<double, double>> points;  // (t s, coverage %), t increasing
   Rgb color{0, 0, 0};                             // {0,0,0}: palette(index)
   int thickness = 2;
+  std::vector<BandPoint> band;  // drawn faded in the series' colour under every curve; t increasing
 };
 
 // The series of one run's coverage samples.

@@ -12,7 +12,10 @@
 //   pic.write_png("run/map.png");
 //
 // Nothing of OpenCV shows here: the columns are classified when the picture is made, overlays
-// are kept as values and drawn by render().
+// are kept as values and drawn by render(). Overlays are clipped to the map's frame (the title,
+// scale bar and legend around it stay clear), and their labels are placed last, on top, by a
+// LabelPlacer (label_placer.hpp): none overlaps another or a labelled marker, a crowded one
+// moves out with a leader line or is left out.
 #pragma once
 
 #include <Eigen/Core>
@@ -69,9 +72,16 @@ class MapPicture {
   void add_polyline(const std::vector<Eigen::Vector2d>& points, Rgb color, int thickness_px = 2);
   void add_polyline(const std::vector<Eigen::Vector3d>& points, Rgb color, int thickness_px = 2);
   void add_segment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, Rgb color, int thickness_px = 1);
-  // A circle of radius_m (filled or outlined) with an optional label beside it.
+  // Many segments blended over what lies beneath at `alpha` (0..1) as one layer, so that
+  // thousands of roadmap edges fade into the map instead of burying it.
+  void add_segments(const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& segments, Rgb color,
+                    int thickness_px = 1, double alpha = 1.0);
+  // Many small dots without outline or label (roadmap nodes), blended at `alpha`.
+  void add_dots(const std::vector<Eigen::Vector2d>& points, Rgb color, int radius_px = 1, double alpha = 1.0);
+  // A circle of radius_m (filled or outlined, its outline blended at `alpha`) with an optional
+  // label at its centre.
   void add_circle(const Eigen::Vector2d& center, double radius_m, Rgb color, const std::string& label = "",
-                  bool filled = false, int thickness_px = 2);
+                  bool filled = false, int thickness_px = 2, double alpha = 1.0);
   // A dot of fixed pixel size (start, end, nodes), with an optional label.
   void add_marker(const Eigen::Vector2d& p, Rgb color, const std::string& label = "", int radius_px = 5);
   void add_text(const Eigen::Vector2d& p, const std::string& text, Rgb color);
@@ -95,13 +105,14 @@ class MapPicture {
 
  private:
   struct Overlay {
-    enum Kind { kPolyline, kCircle, kMarker, kText, kArrow } kind;
-    std::vector<Eigen::Vector2d> points;
+    enum Kind { kPolyline, kCircle, kMarker, kText, kArrow, kSegments, kDots } kind;
+    std::vector<Eigen::Vector2d> points;  // kSegments: pairs
     double radius = 0;
     Rgb color;
     std::string text;
     bool filled = false;
     int thickness = 1;
+    double alpha = 1.0;
   };
 
   MapView view_;
@@ -113,6 +124,10 @@ class MapPicture {
   std::vector<Overlay> overlays_;
   std::vector<std::pair<std::string, Rgb>> legend_;
 };
+
+// The trajectory's colour in map.png: a saturated blue no other overlay uses, drawn last on a
+// white halo so the flight stands out of the roadmap and the regions.
+inline constexpr Rgb kTrajectoryColour{0, 70, 255};
 
 // The evaluator's map.png: the map over the world's area (MapView::of_world), the ground truth's
 // walls the map does not know (when `gt` is given), and the flown trajectory with its start and

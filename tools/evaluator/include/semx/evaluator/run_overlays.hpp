@@ -16,8 +16,14 @@ namespace semx::evaluator {
 struct RoadmapOverlay {
   std::vector<Eigen::Vector2d> nodes;
   std::vector<bool> frontier;  // per node: it still sees unknown space (gain)
+  std::vector<double> gain;    // per node: its G(n) (empty: not known)
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> edges;
 };
+
+// The nodes map.png marks as informative: frontier nodes whose gain is at least a quarter of
+// the roadmap's highest (every frontier node when no gains are given). Nearly every DEP node
+// sees some unknown voxel, so the flag alone marks the whole roadmap.
+std::vector<size_t> informative_nodes(const RoadmapOverlay& roadmap);
 
 struct RegionOverlay {
   Eigen::Vector2d centre;
@@ -26,7 +32,8 @@ struct RegionOverlay {
   bool active = true;  // still attracting the planner
 };
 
-// Edges first (thin, light), then nodes, then regions with their labels on top.
+// Edges first (thin, faded), then nodes (1 px grey dots; informative ones 2 px orange),
+// then regions (faded circles) with their labels placed on top.
 void add_roadmap(MapPicture& picture, const RoadmapOverlay& roadmap);
 void add_regions(MapPicture& picture, const std::vector<RegionOverlay>& regions);
 
