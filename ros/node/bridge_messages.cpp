@@ -4,6 +4,7 @@
 
 #include "semx/runtime/camera_info.hpp"
 #include "semx/runtime/image_codec.hpp"
+#include "semx/runtime/roadmap_messages.hpp"
 
 namespace semx::rosbridge {
 
@@ -54,8 +55,8 @@ bool accept_regions(const semx::semantic_regions_t& m) {
 bool accept_status(const semx::planner_status_t& m) { return finite(m.goal); }
 
 bool accept_command(const semx::control_cmd_t& m) {
-  return finite(m.setpoint) && std::isfinite(m.yaw) && std::isfinite(m.yaw_rate) && m.mode >= 0 && m.mode <= 2 &&
-         (m.yaw_mode == 0 || m.yaw_mode == 1);
+  return finite(m.setpoint) && std::isfinite(m.yaw) && std::isfinite(m.yaw_rate) && m.mode >= 0 &&
+         m.mode <= 2 && (m.yaw_mode == 0 || m.yaw_mode == 1);
 }
 
 bool accept_trajectory(const semx::trajectory_t& m) {
@@ -71,7 +72,8 @@ VehicleOdometry from_message(const semx::odometry_t& m) {
   VehicleOdometry o;
   o.utime = m.utime;
   o.position = vec(m.position);
-  o.orientation = Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]).normalized();
+  o.orientation =
+      Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]).normalized();
   o.velocity = vec(m.velocity);
   o.angular_velocity = vec(m.angular_velocity);
   return o;
@@ -116,13 +118,15 @@ std::string from_message(const semx::label_image_t& m, LabelFrame& out) {
 std::string from_message(const semx::rgb_image_t& m, RgbFrame& out) {
   out.shot = shot_of(m.info, m.utime);
   std::string error;
-  if (!runtime::decode_image(m.rgb_compression, m.rgb_data, 3 * pixels(m.info), out.rgb, &error)) return error;
+  if (!runtime::decode_image(m.rgb_compression, m.rgb_data, 3 * pixels(m.info), out.rgb, &error))
+    return error;
   return "";
 }
 
 semx::depth_image_t to_message(const DepthFrame& f) {
-  return runtime::depth_image_message(f.shot.camera, f.shot.T_world_optical, f.depth_mm.data(), f.depth_mm.size(),
-                                      f.shot.utime, f.shot.frame_id, runtime::ImageCompression::kNone);
+  return runtime::depth_image_message(f.shot.camera, f.shot.T_world_optical, f.depth_mm.data(),
+                                      f.depth_mm.size(), f.shot.utime, f.shot.frame_id,
+                                      runtime::ImageCompression::kNone);
 }
 
 semx::label_image_t to_message(const LabelFrame& f) {
@@ -144,48 +148,9 @@ semx::label_image_t to_message(const LabelFrame& f) {
   return m;
 }
 
-Roadmap from_message(const semx::roadmap_t& m) {
-  Roadmap r;
-  r.utime = m.utime;
-  r.iteration = m.iteration;
-  for (const auto& n : m.nodes) {
-    RoadmapNode v;
-    v.id = n.id;
-    v.position = vec(n.position);
-    v.yaw = n.yaw;
-    v.gain = n.gain;
-    v.reward = n.reward;
-    v.cost = n.cost;
-    v.score = n.score;
-    v.flags = n.flags;
-    r.nodes.push_back(v);
-  }
-  for (std::size_t i = 0; i < m.edge_from.size() && i < m.edge_to.size(); ++i) {
-    r.edges.emplace_back(m.edge_from[i], m.edge_to[i]);
-  }
-  return r;
-}
+Roadmap from_message(const semx::roadmap_t& m) { return runtime::roadmap_from(m); }
 
-std::vector<Region> from_message(const semx::semantic_regions_t& m) {
-  std::vector<Region> out;
-  for (const auto& r : m.regions) {
-    Region v;
-    v.id = r.id;
-    v.class_id = r.class_id;
-    v.label = r.label;
-    v.instance = r.instance;
-    v.centroid = vec(r.centroid);
-    v.weight = r.weight;
-    v.radius = r.radius;
-    v.extent = vec(r.extent);
-    v.confidence = r.confidence;
-    v.observations = r.observations;
-    v.observed_fraction = r.observed_fraction;
-    v.active = r.active;
-    out.push_back(std::move(v));
-  }
-  return out;
-}
+std::vector<Region> from_message(const semx::semantic_regions_t& m) { return runtime::regions_from(m); }
 
 PlannerStatus from_message(const semx::planner_status_t& m) {
   PlannerStatus s;

@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "semx/runtime/channels.hpp"
+#include "semx/runtime/roadmap_messages.hpp"
 
 namespace semx::viewer {
 
@@ -32,49 +33,6 @@ map::MapClientOptions client_options(const runtime::Node& node) {
 }
 
 Eigen::Vector3d vec3(const double* v) { return {v[0], v[1], v[2]}; }
-
-Roadmap roadmap_from(const semx::roadmap_t& m) {
-  Roadmap r;
-  r.utime = m.utime;
-  r.iteration = m.iteration;
-  r.nodes.reserve(m.nodes.size());
-  for (const auto& n : m.nodes) {
-    RoadmapNode x;
-    x.id = n.id;
-    x.position = vec3(n.position);
-    x.yaw = n.yaw;
-    x.gain = n.gain;
-    x.reward = n.reward;
-    x.cost = n.cost;
-    x.score = n.score;
-    x.flags = static_cast<uint8_t>(n.flags);
-    r.nodes.push_back(x);
-  }
-  // The wire validator makes both arrays num_edges long; min() guards a hand-built message.
-  const size_t ne = std::min(m.edge_from.size(), m.edge_to.size());
-  r.edges.reserve(ne);
-  for (size_t i = 0; i < ne; ++i) r.edges.emplace_back(m.edge_from[i], m.edge_to[i]);
-  return r;
-}
-
-std::vector<Region> regions_from(const semx::semantic_regions_t& m) {
-  std::vector<Region> out;
-  out.reserve(m.regions.size());
-  for (const auto& s : m.regions) {
-    Region r;
-    r.id = s.id;
-    r.class_id = s.class_id;
-    r.label = s.label;
-    r.centroid = vec3(s.centroid);
-    r.weight = s.weight;
-    r.radius = s.radius;
-    r.confidence = s.confidence;
-    r.observed_fraction = s.observed_fraction;
-    r.active = s.active;
-    out.push_back(std::move(r));
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -104,11 +62,11 @@ ViewerNode::ViewerNode(runtime::Node& node, ViewerNodeOptions options)
   });
   node_.subscribe<semx::roadmap_t>(ch::ROADMAP, [this](const semx::roadmap_t& m) {
     message_time(m.utime);
-    view_.set_roadmap(roadmap_from(m));
+    view_.set_roadmap(runtime::roadmap_from(m));
   });
   node_.subscribe<semx::semantic_regions_t>(ch::SEMANTIC_REGIONS, [this](const semx::semantic_regions_t& m) {
     message_time(m.utime);
-    view_.set_regions(regions_from(m));
+    view_.set_regions(runtime::regions_from(m));
   });
   node_.subscribe<semx::path_t>(ch::PLAN_PATH, [this](const semx::path_t& m) {
     message_time(m.utime);
