@@ -882,11 +882,14 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
     if (!n.alive || n.passage || n.id == g || n.id == root_ || !search_.reached(n.id)) continue;
     if (static_cast<size_t>(n.id) >= to_goal.distance.size() || !to_goal.reached(n.id)) continue;
     if (n.blacklisted_until >= ctx.cycle || !n.gain.valid || n.gain.gain < min_gain) continue;
-    // Left behind: nearer the vehicle than the goal (what is near the goal, its visit sees).
-    const size_t i = static_cast<size_t>(n.id);
-    if (search_.distance[i] >= to_goal.distance[i]) continue;
     const double d = detour_of(n.id);
-    if (d <= budget && !(config_.loop.pocket_skip_passing && in_passing(n.id))) near.emplace_back(d, n.id);
+    if (d > budget) continue;
+    // Left behind: nearer the vehicle than the goal (what is near the goal, its visit sees), and
+    // not seen in passing.
+    const size_t i = static_cast<size_t>(n.id);
+    if (config_.loop.pocket_left_behind && (search_.distance[i] >= to_goal.distance[i] || in_passing(n.id)))
+      continue;
+    near.emplace_back(d, n.id);
   }
   std::sort(near.begin(), near.end());
   // One stop per pocket: a node within the spacing of a cheaper stop sees about what it sees.

@@ -818,6 +818,7 @@ Goal pocket_case(double pocket, double detour, int* stops, double vehicle = 6.0)
   f.config.gain.min_gain = 400;  // the pocket is informative close by (as in the end game's test)
   f.config.loop.pocket_detour = detour;
   f.config.loop.pocket_max_sites = 16;
+  f.config.loop.pocket_left_behind = true;
   DepStrategy dep(f.config, false);
   dep.on_map_reset();
   PlanOutcome o;

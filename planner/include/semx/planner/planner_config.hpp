@@ -270,9 +270,11 @@ struct LoopConfig {
   // one at the end. 0: off (the score's goal).
   double pocket_detour = 0.0;
   int pocket_max_sites = 8;  // pockets considered per cycle at most (the cheapest detours, one per site)
-  // A node within end_game_site_spacing of the way to the far goal whose best window looks along
-  // the way is seen in passing: not a pocket. false: every informative node whose detour fits.
-  bool pocket_skip_passing = true;
+  // Which informative nodes are pockets. true: only those left behind, i.e. nearer (by path) the
+  // vehicle than the far goal and not seen in passing (within end_game_site_spacing of the way
+  // with the best window looking along it). false: every informative node whose detour fits,
+  // also those on the way (the vehicle stops and looks there on its way to the far goal).
+  bool pocket_left_behind = false;
 };
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").
