@@ -917,7 +917,9 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
   const int n = k + 2;
   const double never = 1e6;
   std::vector<double> cost(static_cast<size_t>(n) * static_cast<size_t>(n), never);
-  auto at = [&](int i, int j) -> double& { return cost[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)]; };
+  auto at = [&](int i, int j) -> double& {
+    return cost[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)];
+  };
   at(0, k + 1) = trip;
   for (int i = 1; i <= k; ++i) {
     const int64_t a = sites[static_cast<size_t>(i - 1)];
@@ -947,13 +949,16 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
     p.cost.assign(static_cast<size_t>(p.n) * static_cast<size_t>(p.n), 0.0);
     for (int i = 0; i < p.n; ++i)
       for (int j = 0; j < p.n; ++j)
-        if (i != j) p.cost[static_cast<size_t>(i * p.n + j)] = at(full[static_cast<size_t>(i)], full[static_cast<size_t>(j)]);
+        if (i != j)
+          p.cost[static_cast<size_t>(i * p.n + j)] =
+              at(full[static_cast<size_t>(i)], full[static_cast<size_t>(j)]);
     const Tour t = solve_open_tour(p, 10);
     std::vector<int> route;  // full indices: pockets in order, then the goal
     for (int o : t.order) route.push_back(full[static_cast<size_t>(o)]);
     if (route.back() != k + 1 || t.cost >= never) {
       // Some pocket cannot be left toward the goal: drop the last-ordered pocket and try again.
-      keep.erase(std::find(keep.begin(), keep.end(), route.back() == k + 1 ? route[route.size() - 2] : route.back()));
+      keep.erase(std::find(keep.begin(), keep.end(),
+                           route.back() == k + 1 ? route[route.size() - 2] : route.back()));
       continue;
     }
     if (t.cost - trip <= budget) {
@@ -965,7 +970,8 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
     for (size_t r = 0; r + 1 < route.size(); ++r) {
       const int prev = r == 0 ? 0 : route[r - 1];
       const double saves = at(prev, route[r]) + at(route[r], route[r + 1]) - at(prev, route[r + 1]);
-      const double per = saves / std::max(1.0, graph_.node(sites[static_cast<size_t>(route[r] - 1)]).gain.gain);
+      const double per =
+          saves / std::max(1.0, graph_.node(sites[static_cast<size_t>(route[r] - 1)]).gain.gain);
       if (per > best) {
         best = per;
         drop = r;

@@ -171,7 +171,8 @@ void ExplorationPlanner::close_yield() {
 
 double ExplorationPlanner::min_gain_now() const {
   const double base = config_.gain.min_gain;
-  if (config_.loop.yield_goals <= 0 || yields_.size() < static_cast<size_t>(config_.loop.yield_goals)) return base;
+  if (config_.loop.yield_goals <= 0 || yields_.size() < static_cast<size_t>(config_.loop.yield_goals))
+    return base;
   double promised = 0, delivered = 0;
   for (const Yield& y : yields_) promised += y.promised, delivered += static_cast<double>(y.delivered);
   // Delivery is counted in voxels and the gain in weighted voxels (a surface voxel counts 4):

@@ -769,7 +769,8 @@ TEST(DepRoadmap, TheEndGameFliesTheShortestTourThroughThePocketsLeft) {
     DepFixture f;
     const SyntheticWorld w = SyntheticWorld::room({18, 4, 2.5}, {7, 2, 1.2});
     w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(18.2, 4.2, 2.7)});
-    for (double x : {0.5, 10.0, 17.0}) fill_m(f.grid, {x - 0.45, 1.55, 0.05}, {x + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
+    for (double x : {0.5, 10.0, 17.0})
+      fill_m(f.grid, {x - 0.45, 1.55, 0.05}, {x + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
     f.frontiers.reset(f.grid);
     // Pockets of a few hundred voxels: informative only close by (the test's sparser gain rays
     // count fewer than the default).
@@ -813,7 +814,8 @@ Goal pocket_case(double pocket, double detour, int* stops, double vehicle = 6.0)
   const SyntheticWorld w = SyntheticWorld::room({18, 4, 2.5}, {vehicle, 2, 1.2});
   w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(18.2, 4.2, 2.7)});
   fill_m(f.grid, {14.5, 0.5, 0.05}, {17.5, 3.5, 1.05}, VoxelState::kUnknown);
-  if (pocket > 0) fill_m(f.grid, {pocket - 0.45, 1.55, 0.05}, {pocket + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
+  if (pocket > 0)
+    fill_m(f.grid, {pocket - 0.45, 1.55, 0.05}, {pocket + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
   f.frontiers.reset(f.grid);
   f.config.gain.min_gain = 400;  // the pocket is informative close by (as in the end game's test)
   f.config.loop.pocket_detour = detour;
