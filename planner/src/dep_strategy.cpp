@@ -823,18 +823,26 @@ Goal DepStrategy::tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops) 
     const Tour t = solve_open_tour(p, 10);
     first = sites[static_cast<size_t>(t.order.front() - 1)];
   }
-  const size_t i = static_cast<size_t>(first);
-  const RoadmapNode& n = graph_.node(first);
-  const View v = view_of(ctx, score, first, false);
+  return stop_goal(ctx, score, first);
+}
+
+Goal DepStrategy::stop_goal(PlanContext& ctx, const ScoreFn& score, int64_t id) {
+  const size_t i = static_cast<size_t>(id);
+  const RoadmapNode& n = graph_.node(id);
+  const View v = view_of(ctx, score, id, false);
+  // flown_path turns to yaw_: the window the stop was chosen for (its gain may have been
+  // refreshed since select_goal rated it).
+  yaw_[i] = v.yaw;
+  Goal goal;
   goal.valid = true;
-  goal.node = first;
+  goal.node = id;
   goal.position = n.position;
   goal.yaw = v.yaw;
   goal.gain = v.gain;
   goal.reward = v.reward;
   goal.cost = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
   goal.score = v.score;
-  FlownPath f = flown_path(ctx, first);
+  FlownPath f = flown_path(ctx, id);
   goal.waypoints = std::move(f.waypoints);
   goal.yaws = std::move(f.yaws);
   return goal;
@@ -980,24 +988,8 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
     keep.erase(std::find(keep.begin(), keep.end(), route[drop]));
   }
   if (order.empty()) return goal;
-  const int64_t first = sites[static_cast<size_t>(order.front() - 1)];
-  const size_t i = static_cast<size_t>(first);
-  const RoadmapNode& node = graph_.node(first);
-  const View v = view_of(ctx, score, first, false);
-  // flown_path turns to the yaw this cycle scored the node with: the window the detour counted.
-  yaw_[i] = v.yaw;
-  goal.valid = true;
+  goal = stop_goal(ctx, score, sites[static_cast<size_t>(order.front() - 1)]);
   goal.held = true;
-  goal.node = first;
-  goal.position = node.position;
-  goal.yaw = v.yaw;
-  goal.gain = v.gain;
-  goal.reward = v.reward;
-  goal.cost = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
-  goal.score = v.score;
-  FlownPath f = flown_path(ctx, first);
-  goal.waypoints = std::move(f.waypoints);
-  goal.yaws = std::move(f.yaws);
   *stops = static_cast<int>(order.size());
   return goal;
 }

@@ -143,6 +143,8 @@ class DepStrategy : public Strategy {
   // vehicle through informative nodes to `far` (the score's goal) whose time exceeds the direct
   // trip's by at most pocket_detour x that trip; invalid when no pocket fits. `stops`: the pockets.
   Goal pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& score, int* stops);
+  // A tour's stop as the goal: the node at its best window, the roadmap path to it.
+  Goal stop_goal(PlanContext& ctx, const ScoreFn& score, int64_t id);
 
   PlannerConfig config_;
   bool semantic_;
