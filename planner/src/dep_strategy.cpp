@@ -616,6 +616,16 @@ PlanOutcome DepStrategy::plan_with(PlanContext& ctx, const TierFn* tier) {
       out.tour_stops = stops;
     }
   }
+  // After the score, the same for dep and semantic-dep (semantic-room orders goals by its own
+  // tiers and is left as measured).
+  if (out.goal.valid && out.tour_stops == 0 && !tier && config_.loop.pocket_detour > 0) {
+    int stops = 0;
+    Goal g = pocket_goal(ctx, out.goal, paper_score(), &stops);
+    if (g.valid) {
+      out.goal = std::move(g);
+      out.pocket_stops = stops;
+    }
+  }
   ctx.counters->box_checks += checker_.box_checks();
   checker_.reset_counters();
   return out;
@@ -813,20 +823,174 @@ Goal DepStrategy::tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops) 
     const Tour t = solve_open_tour(p, 10);
     first = sites[static_cast<size_t>(t.order.front() - 1)];
   }
-  const size_t i = static_cast<size_t>(first);
-  const RoadmapNode& n = graph_.node(first);
-  const View v = view_of(ctx, score, first, false);
+  return stop_goal(ctx, score, first);
+}
+
+Goal DepStrategy::stop_goal(PlanContext& ctx, const ScoreFn& score, int64_t id) {
+  const size_t i = static_cast<size_t>(id);
+  const RoadmapNode& n = graph_.node(id);
+  const View v = view_of(ctx, score, id, false);
+  // flown_path turns to yaw_: the window the stop was chosen for (its gain may have been
+  // refreshed since select_goal rated it).
+  yaw_[i] = v.yaw;
+  Goal goal;
   goal.valid = true;
-  goal.node = first;
+  goal.node = id;
   goal.position = n.position;
   goal.yaw = v.yaw;
   goal.gain = v.gain;
   goal.reward = v.reward;
   goal.cost = travel_time(search_.distance[i], ctx.pose.yaw, v.yaw, config_.cost);
   goal.score = v.score;
-  FlownPath f = flown_path(ctx, first);
+  FlownPath f = flown_path(ctx, id);
   goal.waypoints = std::move(f.waypoints);
   goal.yaws = std::move(f.yaws);
+  return goal;
+}
+
+Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& score, int* stops) {
+  Goal goal;
+  *stops = 0;
+  const int64_t g = far.node;
+  const double trip = far.cost;
+  const double budget = config_.loop.pocket_detour * trip;
+  if (!graph_.alive(g) || !(budget > 0)) return goal;
+  const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
+  core::Stopwatch w;
+  // The graph is undirected: distances from the goal are distances to it.
+  const Roadmap::Search to_goal = graph_.shortest_paths(g);
+  ctx.counters->search_settled += to_goal.settled;
+  auto yaw_of = [&](int64_t id) { return graph_.node(id).gain.yaw; };
+  // The way to the goal: a node the vehicle passes within a site's spacing, whose best window
+  // looks along the way there, is seen in passing and is no pocket.
+  std::vector<Eigen::Vector3d> way;
+  for (int64_t id : Roadmap::path_to(search_, g)) way.push_back(graph_.node(id).position);
+  const double half_fov = 0.5 * config_.gain.horizontal_fov();
+  auto in_passing = [&](int64_t id) {
+    const Eigen::Vector3d& p = graph_.node(id).position;
+    for (size_t j = 1; j < way.size(); ++j) {
+      const Eigen::Vector3d d = way[j] - way[j - 1];
+      if (d.head<2>().norm() < 1e-6) continue;
+      const double t = std::clamp((p - way[j - 1]).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      if ((way[j - 1] + t * d - p).norm() < config_.loop.end_game_site_spacing &&
+          core::yaw_distance(std::atan2(d.y(), d.x()), yaw_of(id)) < half_fov)
+        return true;
+    }
+    return false;
+  };
+  auto detour_of = [&](int64_t id) {
+    const size_t i = static_cast<size_t>(id);
+    return travel_time(search_.distance[i], ctx.pose.yaw, yaw_of(id), config_.cost) +
+           travel_time(to_goal.distance[i], yaw_of(id), far.yaw, config_.cost) - trip;
+  };
+  // Candidates by their own detour (the cached gain is an upper bound: a stale one is refreshed
+  // only when its detour fits).
+  std::vector<std::pair<double, int64_t>> near;
+  for (const RoadmapNode& n : graph_.slots()) {
+    if (!n.alive || n.passage || n.id == g || n.id == root_ || !search_.reached(n.id)) continue;
+    if (static_cast<size_t>(n.id) >= to_goal.distance.size() || !to_goal.reached(n.id)) continue;
+    if (n.blacklisted_until >= ctx.cycle || !n.gain.valid || n.gain.gain < min_gain) continue;
+    const double d = detour_of(n.id);
+    if (d > budget) continue;
+    // Left behind: nearer the vehicle than the goal (what is near the goal, its visit sees), and
+    // not seen in passing.
+    const size_t i = static_cast<size_t>(n.id);
+    if (config_.loop.pocket_left_behind && (search_.distance[i] >= to_goal.distance[i] || in_passing(n.id)))
+      continue;
+    near.emplace_back(d, n.id);
+  }
+  std::sort(near.begin(), near.end());
+  // One stop per pocket: a node within the spacing of a cheaper stop sees about what it sees.
+  std::vector<int64_t> sites;
+  const double spacing2 = config_.loop.end_game_site_spacing * config_.loop.end_game_site_spacing;
+  for (const auto& [d, id] : near) {
+    if (static_cast<int>(sites.size()) >= config_.loop.pocket_max_sites) break;
+    if (graph_.node(id).gain_stale) {
+      evaluate_gain(ctx, id);
+      if (graph_.node(id).gain.gain < min_gain || detour_of(id) > budget) continue;
+    }
+    if (nothing_to_do(ctx, id, yaw_of(id))) continue;
+    const Eigen::Vector3d& p = graph_.node(id).position;
+    bool crowded = false;
+    for (int64_t s : sites) crowded = crowded || (graph_.node(s).position - p).squaredNorm() < spacing2;
+    if (!crowded) sites.push_back(id);
+  }
+  if (sites.empty()) {
+    ctx.counters->search_ms += w.ms();
+    return goal;
+  }
+  // The tour: node 0 the vehicle, 1..k the pockets, k+1 the far goal, which must come last
+  // (leaving it costs more than any tour).
+  const int k = static_cast<int>(sites.size());
+  const int n = k + 2;
+  const double never = 1e6;
+  std::vector<double> cost(static_cast<size_t>(n) * static_cast<size_t>(n), never);
+  auto at = [&](int i, int j) -> double& {
+    return cost[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)];
+  };
+  at(0, k + 1) = trip;
+  for (int i = 1; i <= k; ++i) {
+    const int64_t a = sites[static_cast<size_t>(i - 1)];
+    at(0, i) = travel_time(search_.distance[static_cast<size_t>(a)], ctx.pose.yaw, yaw_of(a), config_.cost);
+    at(i, k + 1) = travel_time(to_goal.distance[static_cast<size_t>(a)], yaw_of(a), far.yaw, config_.cost);
+    const Roadmap::Search from = graph_.shortest_paths(a);
+    ctx.counters->search_settled += from.settled;
+    for (int j = 1; j <= k; ++j) {
+      const int64_t b = sites[static_cast<size_t>(j - 1)];
+      if (i != j && from.reached(b))
+        at(i, j) = travel_time(from.distance[static_cast<size_t>(b)], yaw_of(a), yaw_of(b), config_.cost);
+    }
+  }
+  ctx.counters->search_ms += w.ms();
+  // Solve, and while the tour adds more than the budget, drop the pocket whose removal saves the
+  // most time per weighted voxel it would have shown.
+  std::vector<int> keep(static_cast<size_t>(k));
+  for (int i = 0; i < k; ++i) keep[static_cast<size_t>(i)] = i + 1;
+  std::vector<int> order;  // indices into the full problem, the far goal excluded
+  while (!keep.empty()) {
+    TourProblem p;
+    p.n = static_cast<int>(keep.size()) + 2;
+    std::vector<int> full(keep.size() + 2);
+    full[0] = 0;
+    for (size_t i = 0; i < keep.size(); ++i) full[i + 1] = keep[i];
+    full.back() = k + 1;
+    p.cost.assign(static_cast<size_t>(p.n) * static_cast<size_t>(p.n), 0.0);
+    for (int i = 0; i < p.n; ++i)
+      for (int j = 0; j < p.n; ++j)
+        if (i != j)
+          p.cost[static_cast<size_t>(i * p.n + j)] =
+              at(full[static_cast<size_t>(i)], full[static_cast<size_t>(j)]);
+    const Tour t = solve_open_tour(p, 10);
+    std::vector<int> route;  // full indices: pockets in order, then the goal
+    for (int o : t.order) route.push_back(full[static_cast<size_t>(o)]);
+    if (route.back() != k + 1 || t.cost >= never) {
+      // Some pocket cannot be left toward the goal: drop the last-ordered pocket and try again.
+      keep.erase(std::find(keep.begin(), keep.end(),
+                           route.back() == k + 1 ? route[route.size() - 2] : route.back()));
+      continue;
+    }
+    if (t.cost - trip <= budget) {
+      order.assign(route.begin(), route.end() - 1);
+      break;
+    }
+    double best = -1.0;
+    size_t drop = 0;
+    for (size_t r = 0; r + 1 < route.size(); ++r) {
+      const int prev = r == 0 ? 0 : route[r - 1];
+      const double saves = at(prev, route[r]) + at(route[r], route[r + 1]) - at(prev, route[r + 1]);
+      const double per =
+          saves / std::max(1.0, graph_.node(sites[static_cast<size_t>(route[r] - 1)]).gain.gain);
+      if (per > best) {
+        best = per;
+        drop = r;
+      }
+    }
+    keep.erase(std::find(keep.begin(), keep.end(), route[drop]));
+  }
+  if (order.empty()) return goal;
+  goal = stop_goal(ctx, score, sites[static_cast<size_t>(order.front() - 1)]);
+  goal.held = true;
+  *stops = static_cast<int>(order.size());
   return goal;
 }
 

@@ -171,7 +171,8 @@ void ExplorationPlanner::close_yield() {
 
 double ExplorationPlanner::min_gain_now() const {
   const double base = config_.gain.min_gain;
-  if (config_.loop.yield_goals <= 0 || yields_.size() < static_cast<size_t>(config_.loop.yield_goals)) return base;
+  if (config_.loop.yield_goals <= 0 || yields_.size() < static_cast<size_t>(config_.loop.yield_goals))
+    return base;
   double promised = 0, delivered = 0;
   for (const Yield& y : yields_) promised += y.promised, delivered += static_cast<double>(y.delivered);
   // Delivery is counted in voxels and the gain in weighted voxels (a surface voxel counts 4):
@@ -331,7 +332,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     if (!current) {
       need = true;
       why = "goal no longer informative";
-    } else if (o.tour_stops == 0 && o.goal.valid && o.goal.node != goal_.node &&
+    } else if (o.tour_stops == 0 && !goal_.held && o.goal.valid && o.goal.node != goal_.node &&
                o.goal.score > config_.loop.hysteresis * *current) {
       need = true;
       std::ostringstream s;
@@ -359,6 +360,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
       << o.goal.position.z() << ") gain " << o.goal.gain << " reward " << o.goal.reward << " score "
       << o.goal.score;
     if (o.tour_stops > 0) s << " (end game: first of a tour of " << o.tour_stops << " stops)";
+    if (o.pocket_stops > 0) s << " (first of " << o.pocket_stops << " pockets before a far goal)";
     reason = s.str();
   } else if (need) {
     if (why == "path blocked") {

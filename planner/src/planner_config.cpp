@@ -147,6 +147,9 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("end_game_gain", c.loop.end_game_gain, 0.0, 1e9);
   l.get("end_game_site_spacing", c.loop.end_game_site_spacing, 0.0, 100.0);
   l.get("end_game_max_sites", c.loop.end_game_max_sites, 1, 1000);
+  l.get("pocket_detour", c.loop.pocket_detour, 0.0, 100.0);
+  l.get("pocket_max_sites", c.loop.pocket_max_sites, 1, 16);
+  l.get("pocket_left_behind", c.loop.pocket_left_behind);
 
   auto ch = m.child("charge");
   ch.get("base_s", c.charge.base_s, 0.0, 1e3);

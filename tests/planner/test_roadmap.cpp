@@ -769,7 +769,8 @@ TEST(DepRoadmap, TheEndGameFliesTheShortestTourThroughThePocketsLeft) {
     DepFixture f;
     const SyntheticWorld w = SyntheticWorld::room({18, 4, 2.5}, {7, 2, 1.2});
     w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(18.2, 4.2, 2.7)});
-    for (double x : {0.5, 10.0, 17.0}) fill_m(f.grid, {x - 0.45, 1.55, 0.05}, {x + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
+    for (double x : {0.5, 10.0, 17.0})
+      fill_m(f.grid, {x - 0.45, 1.55, 0.05}, {x + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
     f.frontiers.reset(f.grid);
     // Pockets of a few hundred voxels: informative only close by (the test's sparser gain rays
     // count fewer than the default).
@@ -796,6 +797,72 @@ TEST(DepRoadmap, TheEndGameFliesTheShortestTourThroughThePocketsLeft) {
   ASSERT_TRUE(tour.valid);
   EXPECT_GE(stops, 3) << tour.position.transpose();
   EXPECT_LT(tour.position.x(), 4.0) << "the tour starts at the near end";
+}
+
+}  // namespace
+}  // namespace semx::planner
+
+namespace semx::planner {
+namespace {
+
+// A known 18 x 4 m corridor with a large unknown box on the floor at its far end (x = 14.5-17.5:
+// a room's worth of gain, the score's goal) and a small unknown pocket at x = `pocket` (under a
+// table); the vehicle at x = `vehicle`, facing the far end. With loop.pocket_detour the pocket
+// comes first when the tour through it to the far goal adds at most that fraction of the trip.
+Goal pocket_case(double pocket, double detour, int* stops, double vehicle = 6.0) {
+  DepFixture f;
+  const SyntheticWorld w = SyntheticWorld::room({18, 4, 2.5}, {vehicle, 2, 1.2});
+  w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(18.2, 4.2, 2.7)});
+  fill_m(f.grid, {14.5, 0.5, 0.05}, {17.5, 3.5, 1.05}, VoxelState::kUnknown);
+  if (pocket > 0)
+    fill_m(f.grid, {pocket - 0.45, 1.55, 0.05}, {pocket + 0.45, 2.45, 0.65}, VoxelState::kUnknown);
+  f.frontiers.reset(f.grid);
+  f.config.gain.min_gain = 400;  // the pocket is informative close by (as in the end game's test)
+  f.config.loop.pocket_detour = detour;
+  f.config.loop.pocket_max_sites = 16;
+  f.config.loop.pocket_left_behind = true;
+  DepStrategy dep(f.config, false);
+  dep.on_map_reset();
+  PlanOutcome o;
+  for (int64_t cycle = 1; cycle <= 30; ++cycle) {
+    PlanContext ctx = f.context({vehicle, 2.0, 1.2}, 0.0, cycle);
+    o = dep.plan(ctx);
+  }
+  *stops = o.pocket_stops;
+  EXPECT_EQ(o.goal.held, o.pocket_stops > 0);
+  return o.goal;
+}
+
+TEST(DepRoadmap, APocketNearTheVehicleComesBeforeAFarGoal) {
+  int stops = 0;
+  const Goal greedy = pocket_case(4.0, 0.0, &stops);
+  ASSERT_TRUE(greedy.valid);
+  EXPECT_EQ(stops, 0);
+  EXPECT_GT(greedy.position.x(), 9.0) << "the score: toward the far end";
+  const Goal pocket = pocket_case(4.0, 1.0, &stops);
+  ASSERT_TRUE(pocket.valid);
+  EXPECT_GE(stops, 1);
+  EXPECT_LT(pocket.position.x(), 6.0) << "the pocket behind the vehicle first";
+  EXPECT_LT((pocket.position.head<2>() - Eigen::Vector2d(4.0, 2.0)).norm(), 2.5);
+}
+
+TEST(DepRoadmap, APocketTooFarOffTheWayDoesNotChangeTheGoal) {
+  int stops = 0;
+  const Goal greedy = pocket_case(0.5, 0.0, &stops);
+  ASSERT_TRUE(greedy.valid);
+  // A pocket 5.5 m behind the vehicle: the way there and back adds more than the trip.
+  const Goal kept = pocket_case(0.5, 1.0, &stops);
+  ASSERT_TRUE(kept.valid);
+  EXPECT_EQ(stops, 0);
+  EXPECT_FALSE(kept.held);
+  EXPECT_GT(kept.position.x(), 9.0);
+  EXPECT_LT((kept.position - greedy.position).norm(), 1e-9);
+  // Nor the pocket at x = 4 once the vehicle is at the far end (a short trip, a small budget).
+  const Goal near = pocket_case(4.0, 0.0, &stops, 12.0);
+  const Goal near_rule = pocket_case(4.0, 1.0, &stops, 12.0);
+  ASSERT_TRUE(near.valid && near_rule.valid);
+  EXPECT_EQ(stops, 0);
+  EXPECT_LT((near_rule.position - near.position).norm(), 1e-9);
 }
 
 }  // namespace

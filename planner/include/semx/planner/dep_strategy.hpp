@@ -139,6 +139,12 @@ class DepStrategy : public Strategy {
   // vehicle through the informative nodes, one per end_game_site_spacing (invalid when none).
   bool in_end_game(PlanContext& ctx) const;
   Goal tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops);
+  // Pockets before a far goal (loop.pocket_detour): the first stop of the shortest tour from the
+  // vehicle through informative nodes to `far` (the score's goal) whose time exceeds the direct
+  // trip's by at most pocket_detour x that trip; invalid when no pocket fits. `stops`: the pockets.
+  Goal pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& score, int* stops);
+  // A tour's stop as the goal: the node at its best window, the roadmap path to it.
+  Goal stop_goal(PlanContext& ctx, const ScoreFn& score, int64_t id);
 
   PlannerConfig config_;
   bool semantic_;

@@ -261,6 +261,20 @@ struct LoopConfig {
   double end_game_gain = 0.0;
   double end_game_site_spacing = 1.0;  // m: informative nodes this near a stronger one are one stop
   int end_game_max_sites = 48;         // stops of the tour at most (the most informative)
+  // Pockets before a far goal (DEP and semantic-dep, after the score: docs/planner.md, "The end
+  // game"): when the goal the score chose is far, the informative nodes (gain >= min_gain) that a
+  // tour from the vehicle through them to that goal reaches with at most this fraction of the
+  // direct trip's time added are visited first, in the order of the shortest such tour, each held
+  // until reached or no longer informative. Pockets under tables and on cabinets that lose to a
+  // far room's gain are collected while the vehicle is in their room instead of fetched one by
+  // one at the end. 0: off (the score's goal).
+  double pocket_detour = 0.0;
+  int pocket_max_sites = 8;  // pockets considered per cycle at most (the cheapest detours, one per site)
+  // Which informative nodes are pockets. true: only those left behind, i.e. nearer (by path) the
+  // vehicle than the far goal and not seen in passing (within end_game_site_spacing of the way
+  // with the best window looking along it). false: every informative node whose detour fits,
+  // also those on the way (the vehicle stops and looks there on its way to the far goal).
+  bool pocket_left_behind = false;
 };
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").

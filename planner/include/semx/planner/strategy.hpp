@@ -53,6 +53,10 @@ struct Goal {
   double gain = 0.0, reward = 0.0, cost = 0.0, score = 0.0;
   std::vector<Eigen::Vector3d> waypoints;  // first = the vehicle's position
   std::vector<double> yaws;
+  // A stop chosen after the score (DEP's pockets before a far goal, loop.pocket_detour): the main
+  // loop flies it until it is reached or no longer informative, without switching on score (every
+  // pocket scores below the far goal it was put before).
+  bool held = false;
 };
 
 struct PlanOutcome {
@@ -68,6 +72,9 @@ struct PlanOutcome {
   // flown until it is reached or no longer informative, without switching on score. The tour's
   // stops, 0 when the goal is no tour's.
   int tour_stops = 0;
+  // The goal is the first of this many pockets put before the score's far goal (loop.pocket_detour;
+  // goal.held is set); 0 otherwise.
+  int pocket_stops = 0;
 };
 
 class Strategy {
