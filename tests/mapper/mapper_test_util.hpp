@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -106,6 +107,9 @@ inline double agreement(const map::StateGrid& grid, octomap::OcTree& tree) {
   return total ? static_cast<double>(agree) / total : 1.0;
 }
 
-inline std::string temp_path(const std::string& name) { return ::testing::TempDir() + "semx_mapper_" + name; }
+// Per process: two test runs at once (two checkouts, or CI beside a developer) must not share a file.
+inline std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "semx_mapper_" + std::to_string(::getpid()) + "_" + name;
+}
 
 }  // namespace semx::mapper::test
