@@ -49,6 +49,15 @@ std::vector<std::string> worlds_of(const std::vector<BenchRun>& runs) {
   return {s.begin(), s.end()};
 }
 
+// The runs of one world at one sampling density.
+std::vector<const BenchRun*> runs_in(const std::vector<BenchRun>& runs, const std::string& world,
+                                     int samples) {
+  std::vector<const BenchRun*> out;
+  for (const auto& r : runs)
+    if (r.world == world && r.samples == samples) out.push_back(&r);
+  return out;
+}
+
 std::string fmt(double v, int decimals = 2) {
   char b[64];
   std::snprintf(b, sizeof b, "%.*f", decimals, v);
@@ -289,9 +298,7 @@ void for_each_baseline(const std::vector<BenchRun>& runs, const BenchReportOptio
   for (const auto& w : worlds_of(runs)) {
     const Group ours = select(runs, w, o.sweep_planner, o.comparison_samples);
     if (ours.runs.empty()) continue;
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
     for (const auto& p : planners_of(here)) {
       if (p == o.sweep_planner) continue;
       f(w, p, ours, select(runs, w, p, o.comparison_samples));
@@ -366,9 +373,7 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
         "Time_o (s) | Time_95 (s) | End game (s) |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& w : worlds) {
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
     for (const auto& p : planners_of(here)) {
       const Group g = select(runs, w, p, o.comparison_samples);
       md << "| " << w << " | " << p << " | " << g.runs.size() << " | " << pm(g.metric(&BenchRun::time_f_s))
@@ -390,9 +395,7 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
     for (const auto& w : worlds) {
       const Group oracle = select(runs, w, kOraclePlanner, o.comparison_samples);
       if (oracle.runs.empty()) continue;
-      std::vector<const BenchRun*> here;
-      for (const auto& r : runs)
-        if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+      const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
       auto ratio_of = [&](const Group& g, std::optional<double> BenchRun::*field) {
         int rg = 0, ro = 0;
         const Stat sg = g.reached_time(field, &rg), so = oracle.reached_time(field, &ro);
@@ -504,9 +507,7 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
     std::map<std::string, std::vector<const BenchRun*>> generated;
     std::set<std::string> generated_worlds;
     for (const auto& w : worlds) {
-      std::vector<const BenchRun*> here;
-      for (const auto& r : runs)
-        if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+      const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
       for (const auto& p : planners_of(here)) {
         const Group g = select(runs, w, p, o.comparison_samples);
         split_row(w, p, g.runs);
@@ -580,9 +581,7 @@ std::vector<std::string> write_bench_plots(const std::vector<BenchRun>& all, con
   const std::vector<BenchRun> runs = tabled_only(all);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
     if (here.empty()) continue;
     std::vector<PlotSeries> series;
     double t_max = 0;
@@ -626,9 +625,7 @@ std::vector<std::string> write_bench_montages(const std::vector<BenchRun>& all, 
   const std::vector<BenchRun> runs = tabled_only(all);
   std::vector<std::string> written;
   for (const auto& w : worlds_of(runs)) {
-    std::vector<const BenchRun*> here;
-    for (const auto& r : runs)
-      if (r.world == w && r.samples == o.comparison_samples) here.push_back(&r);
+    const std::vector<const BenchRun*> here = runs_in(runs, w, o.comparison_samples);
     if (here.empty()) continue;
     std::vector<MontageTile> tiles;
     for (const auto& p : planners_of(here)) {
