@@ -2,10 +2,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
 
+#include "semx/core/random.hpp"
 #include "semx/fixtures/synthetic_world.hpp"
 #include "semx/map/state_grid.hpp"
+#include "semx/planner/frontier_tracker.hpp"
 #include "semx/planner/planner_config.hpp"
+#include "semx/planner/strategy.hpp"
 
 namespace semx::planner {
 
@@ -34,5 +40,31 @@ inline PlannerConfig test_config(const std::string& planner = "semantic-dep") {
   c.gain.rays_elevation = 8;
   return c;
 }
+
+// What a strategy's plan() reads besides the strategy itself, for scenes built by hand: the map,
+// its frontiers, the regions, the random numbers and the counters, and a context pointing at them.
+struct PlanScene {
+  explicit PlanScene(const std::string& planner, uint64_t seed = 1)
+      : config(test_config(planner)), rng(seed) {}
+  PlannerConfig config;
+  map::StateGrid grid = map::StateGrid(0.1);
+  FrontierTracker frontiers{1.0};
+  core::SplitMixRng rng;
+  std::vector<SemanticRegion> regions;
+  CycleCounters counters;
+
+  PlanContext context(const Eigen::Vector3d& p, double yaw = 0.0, int64_t cycle = 1) {
+    PlanContext ctx;
+    ctx.grid = &grid;
+    ctx.pose.position = p;
+    ctx.pose.yaw = yaw;
+    ctx.regions = &regions;
+    ctx.frontiers = &frontiers;
+    ctx.cycle = cycle;
+    ctx.rng = &rng;
+    ctx.counters = &counters;
+    return ctx;
+  }
+};
 
 }  // namespace semx::planner

@@ -68,17 +68,11 @@ TEST(Planner, PicksTheGoalFacingTheKnownFrontier) {
 }
 
 // Two nodes mirrored about x = 6 in a corridor with unknown space at both ends: equal gains.
-struct MirrorScene {
-  PlannerConfig config = test_config("semantic-dep");
-  map::StateGrid grid = map::StateGrid(0.1);
-  FrontierTracker frontiers{1.0};
-  core::SplitMixRng rng{1};
-  std::vector<SemanticRegion> regions;
-  CycleCounters counters;
+struct MirrorScene : PlanScene {
   DepStrategy dep{config, true};
   int64_t left = -1, right = -1;
 
-  MirrorScene() {
+  MirrorScene() : PlanScene("semantic-dep") {
     SyntheticWorld::room({12, 4, 2.5}, {6, 2, 1.2})
         .reveal(grid, {Eigen::Vector3d(3.0, -0.2, -0.2), Eigen::Vector3d(8.95, 4.2, 2.7)});
     frontiers.reset(grid);
@@ -90,14 +84,7 @@ struct MirrorScene {
     dep.on_map_reset();
   }
   Goal choose() {
-    PlanContext ctx;
-    ctx.grid = &grid;
-    ctx.pose = pose({6.0, 2.05, 1.25}, 0.5 * core::kPi);
-    ctx.regions = &regions;
-    ctx.frontiers = &frontiers;
-    ctx.cycle = 1;
-    ctx.rng = &rng;
-    ctx.counters = &counters;
+    PlanContext ctx = context({6.0, 2.05, 1.25}, 0.5 * core::kPi);
     dep.process_map_changes(ctx);
     const int64_t root = dep.insert_root(ctx);
     dep.graph().node(root).blacklisted_until = 10;  // the choice is between the two nodes

@@ -306,26 +306,8 @@ TEST(Collision, ARootWhoseBoxCornerTouchesAVoxelMayMoveAwayFromIt) {
 }
 
 // DEP's roadmap over cycles on a partly known map.
-struct DepFixture {
-  PlannerConfig config = test_config("dep");
-  map::StateGrid grid = map::StateGrid(0.1);
-  FrontierTracker frontiers{1.0};
-  core::SplitMixRng rng{7};
-  std::vector<SemanticRegion> regions;
-  CycleCounters counters;
-
-  PlanContext context(const Eigen::Vector3d& p, double yaw = 0.0, int64_t cycle = 1) {
-    PlanContext ctx;
-    ctx.grid = &grid;
-    ctx.pose.position = p;
-    ctx.pose.yaw = yaw;
-    ctx.regions = &regions;
-    ctx.frontiers = &frontiers;
-    ctx.cycle = cycle;
-    ctx.rng = &rng;
-    ctx.counters = &counters;
-    return ctx;
-  }
+struct DepFixture : PlanScene {
+  DepFixture() : PlanScene("dep", 7) {}
 };
 
 // The 10 x 4 m corridor, its first 6 m known (walls included), the rest unknown.

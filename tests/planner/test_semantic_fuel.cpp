@@ -16,16 +16,10 @@ namespace {
 // known but for a small pocket on a cabinet in its corner (a frontier cluster below FUEL's size
 // threshold), the second only its first 1.5 m. The vehicle stands in the first room, nearer the
 // pocket than the second room's frontier.
-struct PocketScene {
-  PlannerConfig config = test_config("semantic-fuel");
-  map::StateGrid grid = map::StateGrid(0.1);
-  FrontierTracker frontiers{1.0};
-  core::SplitMixRng rng{1};
-  std::vector<SemanticRegion> regions;
-  CycleCounters counters;
+struct PocketScene : PlanScene {
   const Eigen::Vector3d pocket{0.25, 3.75, 1.0};
 
-  PocketScene() {
+  PocketScene() : PlanScene("semantic-fuel") {
     const SyntheticWorld w = SyntheticWorld::two_rooms();
     w.reveal(grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
     fill_m(grid, {0.0, 3.5, 0.8}, {0.5, 4.0, 1.2}, map::VoxelState::kUnknown);
@@ -44,15 +38,7 @@ struct PocketScene {
   }
   // The first cluster of the plan's tour: its mean.
   Eigen::Vector3d first_site(FuelStrategy& s) {
-    PlanContext ctx;
-    ctx.grid = &grid;
-    ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
-    ctx.pose.yaw = 0.5 * core::kPi;
-    ctx.regions = &regions;
-    ctx.frontiers = &frontiers;
-    ctx.cycle = 1;
-    ctx.rng = &rng;
-    ctx.counters = &counters;
+    PlanContext ctx = context({1.6, 2.4, 1.2}, 0.5 * core::kPi);
     ctx.need_goal = true;
     const PlanOutcome out = s.plan(ctx);
     EXPECT_TRUE(out.goal.valid) << out.reason;
@@ -111,14 +97,7 @@ TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
   PocketScene s;
   s.config.semantic_fuel.start_turns = 3;
   SemanticFuelStrategy sem(s.config);
-  PlanContext ctx;
-  ctx.grid = &s.grid;
-  ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
-  ctx.pose.yaw = 0.0;
-  ctx.regions = &s.regions;
-  ctx.frontiers = &s.frontiers;
-  ctx.rng = &s.rng;
-  ctx.counters = &s.counters;
+  PlanContext ctx = s.context({1.6, 2.4, 1.2});
   double yaw = 0.0;
   for (int k = 0; k < 3; ++k) {
     ctx.cycle = 2 * k + 1;
@@ -142,15 +121,8 @@ TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
 
 TEST(SemanticFuel, DepFirstFliesDepsGoalUntilItsTimeThenFuelsTour) {
   auto goal = [](Strategy& s, PocketScene& scene, int64_t utime) {
-    PlanContext ctx;
-    ctx.grid = &scene.grid;
-    ctx.pose.position = Eigen::Vector3d(1.6, 2.4, 1.2);
+    PlanContext ctx = scene.context({1.6, 2.4, 1.2});
     ctx.pose.utime = utime;
-    ctx.regions = &scene.regions;
-    ctx.frontiers = &scene.frontiers;
-    ctx.cycle = 1;
-    ctx.rng = &scene.rng;
-    ctx.counters = &scene.counters;
     ctx.min_gain = scene.config.gain.min_gain;
     ctx.need_goal = true;
     return s.plan(ctx).goal;

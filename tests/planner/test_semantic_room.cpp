@@ -15,16 +15,10 @@ namespace {
 // at x 4.0-4.2): the first room is known but for a hidden corner (a pocket of unknown voxels),
 // the second only its first 1.5 m. The vehicle stands in the first room; nodes: one by the
 // pocket, one in the doorway, one in the second room looking at its unknown part.
-struct TwoRoomScene {
-  PlannerConfig config = test_config("semantic-room");
-  map::StateGrid grid = map::StateGrid(0.1);
-  FrontierTracker frontiers{1.0};
-  core::SplitMixRng rng{1};
-  std::vector<SemanticRegion> regions;
-  CycleCounters counters;
+struct TwoRoomScene : PlanScene {
   int64_t pocket = -1, doorway = -1, beyond = -1;
 
-  TwoRoomScene() {
+  TwoRoomScene() : PlanScene("semantic-room") {
     config.gain.min_gain = 300.0;  // the test rays count fewer voxels than the defaults
     const SyntheticWorld w = SyntheticWorld::two_rooms();
     w.reveal(grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
@@ -42,15 +36,7 @@ struct TwoRoomScene {
   }
   Goal choose(DepStrategy& s) {
     s.on_map_reset();
-    PlanContext ctx;
-    ctx.grid = &grid;
-    ctx.pose.position = Eigen::Vector3d(2.5, 1.6, 1.2);
-    ctx.pose.yaw = -0.5 * core::kPi;
-    ctx.regions = &regions;
-    ctx.frontiers = &frontiers;
-    ctx.cycle = 1;
-    ctx.rng = &rng;
-    ctx.counters = &counters;
+    PlanContext ctx = context({2.5, 1.6, 1.2}, -0.5 * core::kPi);
     ctx.min_gain = config.gain.min_gain;
     s.process_map_changes(ctx);
     const int64_t root = s.insert_root(ctx);
