@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "process_harness.hpp"
+#include "semx/runtime/bus_listeners.hpp"
 #include "semx/runtime/lcm_url.hpp"
 #include "semx/runtime/message_auth.hpp"
 #include "semx/runtime/node.hpp"
@@ -541,7 +542,19 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   const std::string out = temp_path("stock.out");
   Process launcher({bin("semx-launch"), set, "--lcm-url", url, "--no-color", "--grace", "3"}, out);
   ASSERT_EQ(launcher.wait(120), 0) << read_file(out);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // The set's last messages (every node's final status) come after its last tick, so nothing
+  // held them for the stock logger: it stops once its socket is empty and it sleeps, which under
+  // a loaded CI machine took longer than the fixed 500 ms this test used to give it.
+  {
+    semx::runtime::BusListeners readers(port, SEMX_BIN_DIR, /*max_hold_s=*/10.0, /*rescan_s=*/0.0);
+    const auto start = std::chrono::steady_clock::now();
+    auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    int quiet = 0;  // in a row: one look can fall between a datagram's arrival and the wake-up
+    while (quiet < 5 && wall() < 15) {
+      quiet = readers.caught_up(wall()) ? quiet + 1 : 0;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
   logger.signal(SIGINT);
   ASSERT_EQ(logger.wait(10), 0) << read_file(temp_path("stock_logger.out"));
 
@@ -555,15 +568,21 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   lcm::LogFile file(ours, "r");
   ASSERT_TRUE(file.good()) << ours;
   std::map<std::string, int> held, missing;
+  std::map<std::string, std::string> where;  // the first missing one: its place in our log
+  int64_t events = 0;
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
+    ++events;
     ++held[ev->channel];
-    if (!recorded.count({ev->channel, std::string(static_cast<const char*>(ev->data), ev->datalen)}))
-      ++missing[ev->channel];
+    if (!recorded.count({ev->channel, std::string(static_cast<const char*>(ev->data), ev->datalen)}) &&
+        missing[ev->channel]++ == 0)
+      where[ev->channel] = "event " + std::to_string(events) + " at " + std::to_string(ev->timestamp) + " us";
   }
   EXPECT_GE(held["CAMERA_DEPTH"], 25) << "3 simulated seconds at 10 Hz";
   EXPECT_GE(held["SIM_CLOCK"], 300);
   for (const auto& [channel, n] : missing)
-    ADD_FAILURE() << n << " of the " << held[channel] << " " << channel
-                  << " messages semx-logger recorded are not in "
-                  << "the stock lcm-logger's log";
+    if (n > 0)
+      ADD_FAILURE() << n << " of the " << held[channel] << " " << channel
+                    << " messages semx-logger recorded are not in the stock lcm-logger's log (the first: "
+                    << where[channel] << " of " << events << ")\n"
+                    << read_file(out);
 }
