@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semx/core/zero_array.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
@@ -82,19 +83,22 @@ class GridSearch {
     double threshold = 0.0;  // ESDF a passable cell needs
     map::VoxelKey origin;    // lattice coordinates of index 0
     int nx = 0, ny = 0, nz = 0;
-    std::vector<uint8_t> cls;
-    std::vector<float> g;
-    std::vector<int32_t> parent;
-    std::vector<uint32_t> stamp;   // g and parent hold for this search when == now
-    std::vector<uint32_t> closed;  // settled in this search when == now
+    // Zero-filled on first touch (core/zero_array.hpp): the box spans the known map, a search
+    // touches a corridor of it, and a growth of the box writes only the cached cells it keeps.
+    // cls starts kUnset (0); g and parent are read only where stamp says this search wrote them.
+    core::ZeroArray<uint8_t> cls;
+    core::ZeroArray<float> g;
+    core::ZeroArray<int32_t> parent;
+    core::ZeroArray<uint32_t> stamp;   // g and parent hold for this search when == now
+    core::ZeroArray<uint32_t> closed;  // settled in this search when == now
     uint32_t now = 0;
     // Per column (x, y) of the coarse lattice: the heights (bit z) it is passable at, and at which
     // of them the clearance is passage_clearance; and the column search's scratch.
-    std::vector<uint8_t> col_set;
-    std::vector<uint64_t> col_pass, col_high;
-    std::vector<float> col_g;
-    std::vector<int32_t> col_parent;
-    std::vector<uint32_t> col_stamp, col_closed;
+    core::ZeroArray<uint8_t> col_set;
+    core::ZeroArray<uint64_t> col_pass, col_high;
+    core::ZeroArray<float> col_g;
+    core::ZeroArray<int32_t> col_parent;
+    core::ZeroArray<uint32_t> col_stamp, col_closed;
     int64_t index(const map::VoxelKey& l) const;
     map::VoxelKey coords(int64_t i) const;
   };
