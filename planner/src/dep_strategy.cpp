@@ -512,10 +512,16 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   };
   int64_t reachable = 0;
   const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
+  // Gain evaluations this cycle may still make (loop.flying_refresh); -1: no bound.
+  int64_t refresh_left = ctx.need_goal || config_.loop.flying_refresh <= 0 ? -1 : config_.loop.flying_refresh;
   for (const RoadmapNode& n : graph_.slots()) {
     if (!n.alive || !search_.reached(n.id)) continue;
     ++reachable;
-    if (!n.gain.valid) evaluate_gain(ctx, n.id);
+    if (!n.gain.valid) {
+      if (refresh_left == 0) continue;  // a node new this cycle waits for the next one's budget
+      --refresh_left;
+      evaluate_gain(ctx, n.id);
+    }
     const RoadmapNode& m = graph_.node(n.id);
     rate(n.id);
     if (m.blacklisted_until >= ctx.cycle || m.passage) continue;
@@ -553,6 +559,8 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
       }
     }
     if (n.gain_stale) {
+      if (refresh_left == 0) continue;  // over this cycle's budget: the best fresh node wins
+      --refresh_left;
       evaluate_gain(ctx, id);
       rate(id);
       const size_t i = static_cast<size_t>(id);

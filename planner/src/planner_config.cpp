@@ -150,6 +150,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("pocket_detour", c.loop.pocket_detour, 0.0, 100.0);
   l.get("pocket_max_sites", c.loop.pocket_max_sites, 1, 16);
   l.get("pocket_left_behind", c.loop.pocket_left_behind);
+  l.get("flying_refresh", c.loop.flying_refresh, 0, 1000000);
 
   auto ch = m.child("charge");
   ch.get("base_s", c.charge.base_s, 0.0, 1e3);

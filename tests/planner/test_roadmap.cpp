@@ -715,6 +715,51 @@ TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   EXPECT_GT(stale, 0);
 }
 
+// loop.flying_refresh: while a goal is flown, a cycle makes at most that many gain evaluations
+// and its goal is a node whose gain is fresh; a cycle that needs a goal evaluates what it needs.
+TEST(DepRoadmap, AFlyingCycleRefreshesAtMostItsBudgetOfGains) {
+  struct Cycle {
+    int64_t evaluations = 0;
+    bool goal = false;        // the cycle found one
+    bool stale_goal = false;  // ... ranked by a gain left stale
+  };
+  auto cycle_after_change = [](int budget, bool need_goal) {
+    Cycle c;
+    DepFixture f;
+    f.config.loop.flying_refresh = budget;
+    corridor(f.grid);
+    f.frontiers.reset(f.grid);
+    DepStrategy dep(f.config, false);
+    dep.on_map_reset();
+    PlanContext ctx = f.context({1, 2, 1.2});
+    ctx.need_goal = true;
+    EXPECT_TRUE(dep.plan(ctx).goal.valid);
+    // Space mapped next to the roadmap makes most of its gains stale.
+    fill_m(f.grid, {6.0, 0.0, 0.0}, {6.5, 4.0, 2.5}, VoxelState::kFree);
+    std::vector<map::VoxelChange> changes;
+    for (double y = 0.05; y < 4.0; y += 0.5) changes.push_back({f.grid.keys().key({6.25, y, 1.0}), VoxelState::kFree});
+    dep.on_map_changes(changes);
+    f.counters = CycleCounters();
+    PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
+    ctx2.need_goal = need_goal;
+    const PlanOutcome out = dep.plan(ctx2);
+    c.evaluations = f.counters.gain_evaluations;
+    c.goal = out.goal.valid;
+    c.stale_goal = out.goal.valid && dep.graph().node(out.goal.node).gain_stale;
+    return c;
+  };
+  const Cycle unbounded = cycle_after_change(0, false);
+  EXPECT_TRUE(unbounded.goal);
+  ASSERT_GT(unbounded.evaluations, 6) << "the change must leave more stale gains than the budget";
+  const Cycle bounded = cycle_after_change(3, false);
+  EXPECT_LE(bounded.evaluations, 3);
+  EXPECT_FALSE(bounded.stale_goal);
+  const Cycle needed = cycle_after_change(3, true);
+  EXPECT_EQ(needed.evaluations, unbounded.evaluations) << "a cycle that needs a goal is not bounded";
+  EXPECT_TRUE(needed.goal);
+  EXPECT_FALSE(needed.stale_goal);
+}
+
 TEST(DepRoadmap, SameSeedSameRoadmap) {
   auto build = [](int64_t seed) {
     DepFixture f;

@@ -275,6 +275,14 @@ struct LoopConfig {
   // with the best window looking along it). false: every informative node whose detour fits,
   // also those on the way (the vehicle stops and looks there on its way to the far goal).
   bool pocket_left_behind = false;
+  // Gain evaluations DEP and semantic-dep make per cycle at most while a goal is flown (of nodes
+  // new this cycle, oldest first, then the lazy ranking's re-evaluations of stale gains): the
+  // ranking that asks "is there a better goal than the one flown?" then takes the best node whose
+  // gain is fresh; new nodes left wait for the next cycle, and the stale ones left at the top are
+  // refreshed first then. A cycle that must choose a goal (none, or reached) evaluates all it needs. It bounds the cycle's CPU in large worlds,
+  // where the map changes near the vehicle re-stale tens of nodes a cycle (docs/planner.md,
+  // "Cycle time"). 0: no bound.
+  int flying_refresh = 0;
 };
 
 // The deterministic charge for planning time (docs/planner.md, "Planning time").
