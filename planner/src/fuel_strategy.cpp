@@ -27,6 +27,7 @@ constexpr int kAttempts = 3;
 // A cluster without viewpoints is sampled again after this many cycles, this many per cycle.
 constexpr int64_t kResampleCycles = 8;
 constexpr int kResampleClusters = 3;
+constexpr int kLookTurns = 4;  // quarter turns in place at most before the first tour goal
 
 const std::vector<Viewpoint> kNoViews;
 
@@ -63,6 +64,9 @@ void FuelStrategy::reset() {
   blacklist_.clear();
   target_ = Target();
   switch_ = false;
+  look_ = Goal();
+  looks_ = 0;
+  toured_ = false;
   replan_reason_.clear();
   velocity_.setZero();
   yaw_speed_ = 0.0;
@@ -533,6 +537,12 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     return out;
   };
 
+  if (look_.valid && !ctx.need_goal) {  // a turn in place is flown to its end
+    out.goal = look_;
+    return finish();
+  }
+  look_ = Goal();
+
   // FUEL's FSM: plan again when a goal is needed, the target is covered, or periodically.
   const FuelConfig& f = config_.fuel;
   std::string why;
@@ -572,10 +582,28 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   switch_ = true;
   if (!p) {
     target_ = Target();
+    if (!toured_ && looks_ < kLookTurns && (!state_.empty() || ctx.grid->free_voxels() == 0)) {
+      // The vehicle has not left its start, and there are clusters, none with a free viewpoint
+      // yet, or it has seen nothing at all (a wall nearer than the camera's least depth).
+      ++looks_;
+      look_.valid = true;
+      look_.position = ctx.pose.position;
+      look_.yaw = core::wrap_angle(ctx.pose.yaw + 0.5 * core::kPi);
+      look_.gain = 1.0;
+      look_.cost = 0.5 * core::kPi / config_.cost.yaw_rate;
+      look_.score = look_.gain / look_.cost;
+      look_.waypoints = {ctx.pose.position};
+      look_.yaws = {look_.yaw};
+      switch_ = true;
+      out.goal = look_;
+      out.reason = "turning in place at the start: " + reason;
+      return finish();
+    }
     out.reason = reason;
     out.unreachable_informative = waiting;
     return finish();
   }
+  toured_ = true;
   target_.valid = true;
   target_.cluster = p->cluster;
   target_.voxels = clusters_.find(p->cluster)->voxels;

@@ -450,6 +450,46 @@ TEST(Fuel, ExploresTheApartmentToDone) {
   EXPECT_LT(r.time_95, r.time_s);
 }
 
+// A start facing a wall: 0.4 m away the camera sees nothing at all (nearer than its least
+// depth); 0.6 m away it sees the wall, whose frontier clusters have no free viewpoint yet (the
+// mapper leaves the camera's first half metre unknown). Either way FUEL turns in place, a quarter
+// turn at a time, instead of ending DONE at once, then explores the room; it does not turn again
+// once it has flown a tour goal (a fully known map ends at once: the next test).
+TEST(Fuel, AStartFacingAWallTurnsInPlaceInsteadOfEndingDone) {
+  for (const double gap : {0.4, 0.6}) {
+    SCOPED_TRACE(gap);
+    const SyntheticWorld w = SyntheticWorld::room({6, 4, 2.5}, {6.0 - gap, 2, 1.2});
+    FuelAudit audit;
+    ExplorationPlanner p(test_config("fuel"));
+    ExplorationSimOptions o;
+    o.max_time = 120;
+    ExplorationSim sim(w, p, o);
+    audit.grid = &sim.known();
+    std::vector<PlannedPath> paths;
+    const ExplorationSimResult r = sim.run([&](double, const ExplorationPlanner::Output& out) {
+      if (!out.path) return;
+      audit.check(*out.path);
+      paths.push_back(*out.path);
+    });
+    ASSERT_FALSE(paths.empty()) << r.reason;
+    // The first path is a turn in place: one waypoint at the start, a quarter turn from yaw 0.
+    EXPECT_EQ(paths.front().waypoints.size(), 1u);
+    EXPECT_LT((paths.front().waypoints.front() - w.start()).norm(), 0.05);
+    EXPECT_NEAR(std::abs(core::wrap_angle(paths.front().yaws.front())), 0.5 * core::kPi, 1e-6);
+    EXPECT_TRUE(r.done) << r.reason;
+    EXPECT_GT(r.coverage, 0.97) << r.reason;
+    EXPECT_EQ(r.collisions, 0);
+    EXPECT_EQ(audit.bad, 0);
+    // At most four turns, all before the first tour goal.
+    size_t turns = 0;
+    while (turns < paths.size() && paths[turns].waypoints.size() == 1 &&
+           (paths[turns].waypoints.front() - w.start()).norm() < 0.05)
+      ++turns;
+    EXPECT_LE(turns, 4u);
+    EXPECT_LT(turns, paths.size());
+  }
+}
+
 TEST(Fuel, DeclaresDoneOnAFullyKnownMap) {
   const SyntheticWorld w = SyntheticWorld::two_rooms();
   map::StateGrid g = w.full_map();

@@ -26,7 +26,12 @@
 //  6. the path: A* over voxels around the coarse path, shortened to segments that pass the
 //     collision check (GridSearch::find_path); yaws turn toward the goal's as fast as cost.yaw_rate
 //     allows along it. A goal without a path is skipped for loop.blacklist_cycles.
-// No cluster with a reachable viewpoint: no goal, with the reason, and the main loop declares DONE.
+// No cluster with a reachable viewpoint: no goal, with the reason, and the main loop declares DONE;
+// except before the first tour goal, when the vehicle first turns in place, a quarter turn at a
+// time (at most four), held to its end: the first camera view can leave the frontier clusters
+// without a free viewpoint (a start facing a wall: a 62 m² generated world ended DONE at 1.2 s
+// with 3.6 % of T), or show nothing at all (a wall nearer than the camera's least depth), and
+// what is around the start gives them one.
 #pragma once
 
 #include <map>
@@ -140,6 +145,9 @@ class FuelStrategy : public Strategy {
   std::vector<Banned> blacklist_;
   Target target_;
   bool switch_ = false;
+  Goal look_;              // the turn in place being flown (before the first tour goal)
+  int looks_ = 0;          // turns made so far
+  bool toured_ = false;    // a tour goal was chosen once
   std::string replan_reason_;
   // This plan's sites and tour (for the roadmap view).
   std::vector<Site> sites_;
