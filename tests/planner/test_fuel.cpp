@@ -490,6 +490,34 @@ TEST(Fuel, AStartFacingAWallTurnsInPlaceInsteadOfEndingDone) {
   }
 }
 
+// A target that counts as covered while its cluster stays (its voxels found unobservable, which
+// changes no cluster) is planned again at once; when the plan chooses the same view, the goal
+// being flown stays (goal_score answers), instead of a new path to the same place every cycle.
+TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
+  PlanScene s("fuel");
+  const SyntheticWorld w = SyntheticWorld::two_rooms();
+  w.reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
+  s.frontiers.reset(s.grid);
+  FuelStrategy fuel(s.config);
+  PlanContext ctx = s.context({1.6, 2.4, 1.2});
+  ctx.need_goal = true;
+  const PlanOutcome first = fuel.plan(ctx);
+  ASSERT_TRUE(first.goal.valid) << first.reason;
+  ASSERT_FALSE(fuel.tour().empty());
+  const FrontierClusters::Cluster* target = fuel.clusters().find(fuel.tour().front());
+  ASSERT_NE(target, nullptr);
+  VoxelSet unobservable;
+  for (const VoxelKey& k : target->voxels) unobservable.insert(k);
+  PlanContext next = s.context({1.6, 2.4, 1.2}, 0.0, 2);
+  next.unobservable = &unobservable;
+  const PlanOutcome again = fuel.plan(next);
+  EXPECT_EQ(fuel.replan_reason().rfind("target covered", 0), 0u) << fuel.replan_reason();
+  ASSERT_TRUE(again.goal.valid);
+  EXPECT_EQ(again.goal.position, first.goal.position);
+  const std::optional<double> score = fuel.goal_score(next, first.goal);
+  EXPECT_TRUE(score.has_value()) << "a replan that chose the same view must not read as a switch";
+}
+
 TEST(Fuel, DeclaresDoneOnAFullyKnownMap) {
   const SyntheticWorld w = SyntheticWorld::two_rooms();
   map::StateGrid g = w.full_map();
