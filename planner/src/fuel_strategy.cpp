@@ -27,8 +27,8 @@ constexpr int kAttempts = 3;
 // A cluster without viewpoints is sampled again after this many cycles, this many per cycle.
 constexpr int64_t kResampleCycles = 8;
 constexpr int kResampleClusters = 3;
-constexpr int kLookTurns = 4;
-constexpr double kSameView = 0.05;  // m and rad: a replanned view this near the target's is the same  // quarter turns in place at most before the first tour goal
+constexpr int kLookTurns = 4;  // quarter turns in place at most before the first tour goal
+constexpr double kSameView = 0.05;  // m and rad: a replanned view this near the target's is the same
 
 const std::vector<Viewpoint> kNoViews;
 
@@ -608,7 +608,6 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
       look_.score = look_.gain / look_.cost;
       look_.waypoints = {ctx.pose.position};
       look_.yaws = {look_.yaw};
-      switch_ = true;
       out.goal = look_;
       out.reason = "turning in place at the start: " + reason;
       return finish();
