@@ -600,14 +600,7 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
       // The vehicle has not left its start, and there are clusters, none with a free viewpoint
       // yet, or it has seen nothing at all (a wall nearer than the camera's least depth).
       ++looks_;
-      look_.valid = true;
-      look_.position = ctx.pose.position;
-      look_.yaw = core::wrap_angle(ctx.pose.yaw + 0.5 * core::kPi);
-      look_.gain = 1.0;
-      look_.cost = 0.5 * core::kPi / config_.cost.yaw_rate;
-      look_.score = look_.gain / look_.cost;
-      look_.waypoints = {ctx.pose.position};
-      look_.yaws = {look_.yaw};
+      look_ = turn_in_place(ctx.pose.position, ctx.pose.yaw, 0.5 * core::kPi, config_.cost.yaw_rate);
       out.goal = look_;
       out.reason = "turning in place at the start: " + reason;
       return finish();

@@ -922,7 +922,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
         if (e.members >> b & 1u) unkept.push_back(e.element);
       if (kept_bytes + unkept.size() * sizeof(int32_t) > keep_budget) return unkept;
       kept_bytes += unkept.size() * sizeof(int32_t);
-      return bin_lists.emplace(key, unkept).first->second;
+      return bin_lists.emplace(key, std::move(unkept)).first->second;
     };
     const auto objective = [&](const std::vector<int>& order) {
       ++gen;

@@ -160,15 +160,7 @@ PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
     }
     if (turn_.valid) ++turns_done_;
     if (turns_done_ < rules_.start_turns) {
-      turn_ = Goal();
-      turn_.valid = true;
-      turn_.position = ctx.pose.position;
-      turn_.yaw = core::wrap_angle(ctx.pose.yaw + 2.0 * core::kPi / rules_.start_turns);
-      turn_.gain = 1.0;
-      turn_.cost = 2.0 * core::kPi / rules_.start_turns / yaw_rate_;
-      turn_.score = turn_.gain / turn_.cost;
-      turn_.waypoints = {ctx.pose.position};
-      turn_.yaws = {turn_.yaw};
+      turn_ = turn_in_place(ctx.pose.position, ctx.pose.yaw, 2.0 * core::kPi / rules_.start_turns, yaw_rate_);
       PlanOutcome o;
       o.goal = turn_;
       return o;

@@ -279,9 +279,10 @@ struct LoopConfig {
   // new this cycle, oldest first, then the lazy ranking's re-evaluations of stale gains): the
   // ranking that asks "is there a better goal than the one flown?" then takes the best node whose
   // gain is fresh; new nodes left wait for the next cycle, and the stale ones left at the top are
-  // refreshed first then. A cycle that must choose a goal (none, or reached) evaluates all it needs. It bounds the cycle's CPU in large worlds,
-  // where the map changes near the vehicle re-stale tens of nodes a cycle (docs/planner.md,
-  // "Cycle time"). 0: no bound.
+  // refreshed first then. A cycle that must choose a goal (none, or reached) evaluates all it
+  // needs. It bounds the cycle's CPU in large worlds, where the map changes near the vehicle
+  // re-stale tens of nodes a cycle, and costs exploration speed (docs/planner.md, "Performance").
+  // 0: no bound.
   int flying_refresh = 0;
 };
 

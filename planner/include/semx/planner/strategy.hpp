@@ -6,12 +6,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "semx/core/angles.hpp"
 #include "semx/core/random.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
@@ -58,6 +60,21 @@ struct Goal {
   // pocket scores below the far goal it was put before).
   bool held = false;
 };
+
+// A turn in place at `at` by `turn` rad from `from_yaw`: its cost the turn's time at `yaw_rate`,
+// a nominal gain of 1 (it looks around; what it will see is not modelled).
+inline Goal turn_in_place(const Eigen::Vector3d& at, double from_yaw, double turn, double yaw_rate) {
+  Goal g;
+  g.valid = true;
+  g.position = at;
+  g.yaw = core::wrap_angle(from_yaw + turn);
+  g.gain = 1.0;
+  g.cost = std::abs(turn) / yaw_rate;
+  g.score = g.gain / g.cost;
+  g.waypoints = {at};
+  g.yaws = {g.yaw};
+  return g;
+}
 
 struct PlanOutcome {
   Goal goal;           // invalid when nothing worth flying to was found
