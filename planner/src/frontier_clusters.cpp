@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 
+#include "semx/map/sort_keys.hpp"
 #include "semx/planner/voxel_set.hpp"
 
 namespace semx::planner {
@@ -68,8 +69,7 @@ FrontierClusters::Changes FrontierClusters::rebuild(std::vector<VoxelKey> voxels
 }
 
 void FrontierClusters::grow(std::vector<VoxelKey> seeds, const Eligible& eligible, Changes& out) {
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  map::sort_unique(seeds);
   VoxelSet visited;
   std::vector<VoxelKey> queue;
   for (const VoxelKey& s : seeds) {

@@ -9,6 +9,7 @@
 
 #include "semx/core/angles.hpp"
 #include "semx/core/stopwatch.hpp"
+#include "semx/map/sort_keys.hpp"
 #include "semx/planner/travel_cost.hpp"
 
 namespace semx::planner {
@@ -141,8 +142,7 @@ void FuelStrategy::update_clusters(PlanContext& ctx) {
     changes = clusters_.rebuild(std::vector<VoxelKey>(all.begin(), all.end()), ok);
     rebuild_ = false;
   } else if (!dirty_.empty()) {
-    std::sort(dirty_.begin(), dirty_.end());
-    dirty_.erase(std::unique(dirty_.begin(), dirty_.end()), dirty_.end());
+    map::sort_unique(dirty_);
     changes = clusters_.update(dirty_, ok);
   }
   dirty_.clear();

@@ -109,10 +109,18 @@ void GridSearch::set_grid(const map::StateGrid* grid) {
 void GridSearch::note_changes(const std::vector<map::VoxelChange>& changes) {
   // By cubes of kDirtyBits^3 voxels, not map blocks: a change invalidates what lies within the
   // ESDF's reach of its cube, and a 16^3 block grown by that reach is four times the volume.
+  // A cell's class reads only whether voxels are free (every other state is an obstacle to it):
+  // unknown -> occupied, most of what a camera adds at the edge of the known space, changes no
+  // cell. A voxel that becomes free can only raise the ESDF around it, so kHigh cells, the top
+  // class, stay: in FUEL's 600 m² run most cells near a growing frontier were kHigh and were
+  // searched again after every map update.
   for (const map::VoxelChange& c : changes) {
+    const bool free_after = c.state == VoxelState::kFree;
+    if (c.previous && (*c.previous == VoxelState::kFree) == free_after) continue;
+    const bool lowers = !c.previous || !free_after;
     const VoxelKey b{c.key.x >> kDirtyBits, c.key.y >> kDirtyBits, c.key.z >> kDirtyBits};
-    dirty_coarse_.insert(b);
-    dirty_fine_.insert(b);
+    dirty_coarse_[b] |= lowers;
+    dirty_fine_[b] |= lowers;
   }
 }
 
@@ -131,7 +139,7 @@ void GridSearch::prepare(Lattice& l) {
   // The fine lattice keeps what a passage node keeps; the coarse one half a cell less (header).
   l.threshold = l.stride == 1 ? collision_.door_clearance
                               : collision_.door_clearance - 0.5 * l.stride * res;
-  std::set<VoxelKey>& dirty = &l == &coarse_ ? dirty_coarse_ : dirty_fine_;
+  std::map<VoxelKey, bool>& dirty = &l == &coarse_ ? dirty_coarse_ : dirty_fine_;
   const map::KeyBox& kb = grid_->known_bounds();
   if (kb.empty()) {
     dirty.clear();
@@ -192,11 +200,11 @@ void GridSearch::prepare(Lattice& l) {
     l = std::move(n);
     if (&l == &coarse_) tree_valid_ = false;
   }
-  for (const VoxelKey& b : dirty) invalidate(l, b);
+  for (const auto& [b, lowers] : dirty) invalidate(l, b, lowers);
   dirty.clear();
 }
 
-void GridSearch::invalidate(Lattice& l, const VoxelKey& block) {  // block: a 4^3 cube (kDirtyBits)
+void GridSearch::invalidate(Lattice& l, const VoxelKey& block, bool lowers) {  // block: a 4^3 cube (kDirtyBits)
   // A voxel changes the ESDF of centres within the checker's cap, and a cell reads the 8 centres
   // around its point: everything within cap + a cell of the block's voxels.
   const double res = grid_->resolution();
@@ -217,7 +225,14 @@ void GridSearch::invalidate(Lattice& l, const VoxelKey& block) {  // block: a 4^
   for (int z = z0; z <= z1; ++z)
     for (int y = y0; y <= y1; ++y) {
       const size_t row = static_cast<size_t>(l.nx) * (static_cast<size_t>(y) + static_cast<size_t>(l.ny) * z);
-      if (x0 <= x1) std::fill(l.cls.begin() + static_cast<long>(row) + x0, l.cls.begin() + static_cast<long>(row) + x1 + 1, kUnset);
+      if (x0 > x1) continue;
+      uint8_t* c = &l.cls[row];
+      if (lowers) {
+        std::fill(c + x0, c + x1 + 1, kUnset);
+      } else {
+        for (int x = x0; x <= x1; ++x)
+          if (c[x] != kHigh) c[x] = kUnset;
+      }
     }
 }
 

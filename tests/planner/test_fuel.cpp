@@ -313,6 +313,53 @@ TEST(GridSearch, ChangesNearACellAreSeenByTheNextSearch) {
   EXPECT_FALSE(s.find_path(a, b, {}, 1000000, path));
 }
 
+TEST(GridSearch, SpaceSeenFreeOrOccupiedGivesWhatAFreshSearchGives) {
+  // The doorway starts unknown (no way through); then the camera sees it free and sees walls in
+  // unknown space elsewhere. The cached search skips unknown -> occupied changes and keeps its
+  // top-class cells near freed voxels: its distances must still be a fresh search's, exactly,
+  // also where a wall piece appears in space known free (that lowers top-class cells).
+  map::StateGrid g = two_known_rooms();
+  fill_m(g, {3.9, 1.5, 0.0}, {4.1, 2.5, 2.1}, VoxelState::kUnknown);
+  fill_m(g, {6.0, 2.8, 0.0}, {8.0, 4.0, 2.5}, VoxelState::kUnknown);
+  const PlannerConfig c = test_config("fuel");
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
+  s.set_grid(&g);
+  const Eigen::Vector3d a(1.5, 0.8, 1.2);
+  const std::vector<Eigen::Vector3d> targets = {{6.5, 0.8, 1.2}, {5.0, 2.5, 1.0}, {7.0, 2.0, 1.5},
+                                                {2.0, 3.5, 1.2}, {3.5, 2.0, 1.2}};
+  ASSERT_FALSE(s.distances(a, true, targets, 1000000, false).distance[0] < 1e9) << "the doorway is unknown";
+  std::vector<map::VoxelChange> changes;
+  const double res = g.resolution();
+  auto set = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, VoxelState st) {
+    for (double z = lo.z() + 0.5 * res; z < hi.z(); z += res)
+      for (double y = lo.y() + 0.5 * res; y < hi.y(); y += res)
+        for (double x = lo.x() + 0.5 * res; x < hi.x(); x += res) {
+          const VoxelKey k = g.keys().key(Eigen::Vector3d(x, y, z));
+          const VoxelState before = g.state(k);
+          if (before == st) continue;
+          g.set_state(k, st);
+          changes.push_back({k, st, before});
+        }
+  };
+  set({3.9, 1.5, 0.0}, {4.1, 2.5, 2.1}, VoxelState::kFree);
+  set({6.0, 2.8, 0.0}, {8.0, 3.0, 2.5}, VoxelState::kFree);
+  set({6.0, 3.0, 0.0}, {8.0, 3.2, 2.5}, VoxelState::kOccupied);
+  set({2.5, 0.0, 0.0}, {2.7, 1.6, 2.5}, VoxelState::kOccupied);  // a wall piece in known free space
+  checker.note_changes(changes);
+  s.note_changes(changes);
+  const GridSearch::Result cached = s.distances(a, true, targets, 1000000, false);
+  CollisionChecker fresh_checker(c.collision);
+  fresh_checker.set_grid(&g);
+  GridSearch fresh(fresh_checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
+  fresh.set_grid(&g);
+  const GridSearch::Result want = fresh.distances(a, true, targets, 1000000, false);
+  EXPECT_TRUE(cached.distance[0] < 1e9) << "the doorway seen free is a way";
+  for (size_t t = 0; t < targets.size(); ++t) EXPECT_EQ(cached.distance[t], want.distance[t]) << "target " << t;
+  EXPECT_EQ(cached.settled, want.settled);
+}
+
 // ---------------------------------------------------------------- viewpoints
 
 map::StateGrid corridor() {

@@ -24,7 +24,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <set>
+#include <map>
 #include <unordered_map>
 #include <vector>
 
@@ -106,7 +106,9 @@ class GridSearch {
   Eigen::Vector3d point(const Lattice& l, const map::VoxelKey& c) const;
   // The grid's known box (padded) fits in the lattice; pending changes are applied.
   void prepare(Lattice& l);
-  void invalidate(Lattice& l, const map::VoxelKey& cube);  // a changed 4^3 cube of voxels
+  // A changed 4^3 cube of voxels: the cells near it are computed again, all of them when a
+  // change there may have lowered the ESDF (lowers), else all but the kHigh ones.
+  void invalidate(Lattice& l, const map::VoxelKey& cube, bool lowers);
   uint8_t cls(Lattice& l, int64_t i);
   // Passability with the escape zone around `source` (when escape).
   uint8_t passable(Lattice& l, int64_t i, const Eigen::Vector3d& source, bool escape);
@@ -126,7 +128,9 @@ class GridSearch {
   double low_penalty_;
   const map::StateGrid* grid_ = nullptr;
   Lattice coarse_, fine_;
-  std::set<map::VoxelKey> dirty_coarse_, dirty_fine_;  // 4^3 cubes changed since each lattice looked
+  // 4^3 cubes changed since each lattice looked, each with whether a change there may have
+  // lowered the ESDF (a voxel that stopped being free, or whose previous state is not known).
+  std::map<map::VoxelKey, bool> dirty_coarse_, dirty_fine_;
   std::unordered_map<int64_t, uint8_t> escape_cache_;  // this search's escape-zone answers
   // The kept tree: its source, and the coarse lattice's g and parent when it was searched.
   bool tree_valid_ = false;
