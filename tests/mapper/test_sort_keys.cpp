@@ -31,7 +31,7 @@ std::vector<VoxelKey> random_keys(int n, int32_t lo, int32_t hi, unsigned seed) 
 TEST(SortKeys, GivesVoxelKeysOrderWithoutRepeatsAroundTheOrigin) {
   // Negative and positive coordinates, a narrow range so repeats abound.
   for (unsigned seed = 1; seed <= 5; ++seed) {
-    std::vector<VoxelKey> keys = random_keys(5000, -20, 20, seed);
+    std::vector<VoxelKey> keys = random_keys(seed % 2 ? 5000 : 300, -20, 20, seed);
     const std::vector<VoxelKey> want = reference(keys);
     semx::map::sort_unique(keys);
     EXPECT_EQ(keys, want) << "seed " << seed;
@@ -39,15 +39,28 @@ TEST(SortKeys, GivesVoxelKeysOrderWithoutRepeatsAroundTheOrigin) {
 }
 
 TEST(SortKeys, KeysSpanningMoreThanThePackingStillSort) {
-  // 2^21 voxels apart on one axis: the packing cannot hold them, the comparison takes over.
+  // Keys at the limits of every axis need 87 bits: the packing cannot hold them, the comparison
+  // takes over.
+  const int32_t m = semx::map::kMaxKeyMagnitude - 1;
   std::vector<VoxelKey> keys = random_keys(2000, -100, 100, 7);
-  keys.push_back({-(1 << 22), 3, 3});
-  keys.push_back({1 << 22, -3, 3});
-  keys.push_back({0, 0, semx::map::kMaxKeyMagnitude - 1});
-  keys.push_back({0, 0, -semx::map::kMaxKeyMagnitude + 1});
+  keys.push_back({-m, 3, -m});
+  keys.push_back({m, -m, 3});
+  keys.push_back({0, m, m});
   const std::vector<VoxelKey> want = reference(keys);
   semx::map::sort_unique(keys);
   EXPECT_EQ(keys, want);
+}
+
+TEST(SortKeys, LongListsOfAWideMapSortAsShortOnes) {
+  // 60 bits of packing (20 an axis): the radix sort's three passes, and the short lists' sort.
+  for (int n : {100, 200000}) {
+    std::vector<VoxelKey> keys = random_keys(n, -(1 << 19), (1 << 19) - 1, 11);
+    keys.push_back({-(1 << 19), -(1 << 19), -(1 << 19)});
+    keys.push_back({(1 << 19) - 1, (1 << 19) - 1, (1 << 19) - 1});
+    const std::vector<VoxelKey> want = reference(keys);
+    semx::map::sort_unique(keys);
+    EXPECT_EQ(keys, want) << n << " keys";
+  }
 }
 
 TEST(SortKeys, EmptyAndSingleKeysStay) {
