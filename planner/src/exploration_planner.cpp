@@ -284,7 +284,7 @@ int64_t ExplorationPlanner::quiet_until(int64_t utime) const {
 }
 
 void ExplorationPlanner::run_cycle(int64_t utime) {
-  core::Stopwatch total;
+  core::CpuStopwatch total;
   CycleCounters c;
   ++iteration_;
   checker_.reset_counters();
