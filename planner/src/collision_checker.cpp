@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #include <limits>
 #include <vector>
 
@@ -25,6 +29,29 @@ CollisionChecker::CollisionChecker(const CollisionConfig& config)
                  0.15) {}
 
 namespace {
+
+// The fills read the states' bits: kFree is 1, kOccupied 2.
+static_assert(static_cast<uint8_t>(VoxelState::kUnknown) == 0 &&
+              static_cast<uint8_t>(VoxelState::kFree) == 1 &&
+              static_cast<uint8_t>(VoxelState::kOccupied) == 2 && sizeof(VoxelState) == 1);
+
+// The obstacles among a block row's 16 states as bits: every state but kFree when
+// unknown_is_obstacle, else kOccupied only.
+inline uint32_t obstacle_bits(const VoxelState* row, bool unknown_is_obstacle) {
+#ifdef __SSE2__
+  const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+  if (unknown_is_obstacle)
+    return ~static_cast<uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_set1_epi8(1)))) & 0xffffu;
+  return static_cast<uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_set1_epi8(2))));
+#else
+  uint32_t bits = 0;
+  for (int i = 0; i < 16; ++i) {
+    const VoxelState s = row[i];
+    if (unknown_is_obstacle ? s != VoxelState::kFree : s == VoxelState::kOccupied) bits |= uint32_t{1} << i;
+  }
+  return bits;
+#endif
+}
 
 // Calls visit(x, y, z) for every obstacle voxel (occupied; unknown too when unknown_is_obstacle,
 // including voxels of blocks never allocated) in the key box [kmin, kmax], block by block, and
@@ -163,42 +190,67 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   const int n = kChunkSize + 2 * reach;
   const int32_t cap2 = reach * reach;
   const VoxelKey o{chunk.x * kChunkSize - reach, chunk.y * kChunkSize - reach, chunk.z * kChunkSize - reach};
-  std::vector<uint8_t>& occ = fill_scratch_.occ;
-  occ.assign(static_cast<size_t>(n) * n * n, 0);
-  for_each_obstacle(
-      *grid_, o, {o.x + n - 1, o.y + n - 1, o.z + n - 1}, unknown_is_obstacle,
-      [](int32_t, int32_t) { return true; },
-      [&](int32_t x, int32_t y, int32_t z) {
-        occ[(static_cast<size_t>(z - o.z) * n + (y - o.y)) * n + (x - o.x)] = 1;
-        return true;
-      });
+  // Each row (y, z) of the region as a mask of its obstacle voxels, bit x for o.x + x, read from
+  // the states sixteen at a time; then each of the chunk's columns finds its nearest obstacle in
+  // the row by counting bits. A byte per voxel, set by visiting the obstacles one by one and
+  // scanned both ways per row, was 60 % of a fill's instructions.
+  static_assert(map::kBlockSize == 16, "a block row is one 16-byte load");
+  if (n > 64) {  // rows wider than a mask (resolutions finer than ~3 cm): one search per centre
+    for (int i = 0; i < kChunkVolume; ++i) {
+      const VoxelKey c{chunk.x * kChunkSize + (i & kChunkMask),
+                       chunk.y * kChunkSize + ((i >> kChunkBits) & kChunkMask),
+                       chunk.z * kChunkSize + (i >> (2 * kChunkBits))};
+      out[static_cast<size_t>(i)] = centre_search(c, reach, unknown_is_obstacle);
+    }
+    return;
+  }
+  std::vector<uint64_t>& rows = fill_scratch_.rows;
+  rows.assign(static_cast<size_t>(n) * n, 0);
+  const VoxelKey hi{o.x + n - 1, o.y + n - 1, o.z + n - 1};
+  const VoxelKey bmin = map::block_of(o), bmax = map::block_of(hi);
+  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz)
+    for (int32_t by = bmin.y; by <= bmax.y; ++by)
+      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
+        const map::VoxelBlock* b = grid_->find_block({bx, by, bz});
+        if (!b && !unknown_is_obstacle) continue;
+        const VoxelKey base{bx * map::kBlockSize, by * map::kBlockSize, bz * map::kBlockSize};
+        const int x0 = std::max(o.x, base.x) - base.x, x1 = std::min(hi.x, base.x + map::kBlockMask) - base.x;
+        const int y0 = std::max(o.y, base.y) - base.y, y1 = std::min(hi.y, base.y + map::kBlockMask) - base.y;
+        const int z0 = std::max(o.z, base.z) - base.z, z1 = std::min(hi.z, base.z + map::kBlockMask) - base.z;
+        const uint32_t keep = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;  // the row's part in the region
+        const int shift = base.x - o.x;                                    // block x to region x
+        for (int z = z0; z <= z1; ++z)
+          for (int y = y0; y <= y1; ++y) {
+            const uint32_t bits =
+                (b ? obstacle_bits(&b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
+                                                                 (y << map::kBlockBits))],
+                                   unknown_is_obstacle)
+                   : 0xffffu) &
+                keep;
+            uint64_t& r = rows[static_cast<size_t>(base.z + z - o.z) * n + (base.y + y - o.y)];
+            r |= shift >= 0 ? static_cast<uint64_t>(bits) << shift : static_cast<uint64_t>(bits) >> -shift;
+          }
+      }
   // gx[z][y][i]: squared x distance from the chunk's column i to the nearest obstacle of row (y, z).
   // Rows and planes with nothing below the cap are skipped by the later passes.
   std::vector<int32_t>& gx = fill_scratch_.gx;
   std::vector<uint8_t>& row_near = fill_scratch_.row_near;
   gx.assign(static_cast<size_t>(n) * n * kChunkSize, cap2);
   row_near.assign(static_cast<size_t>(n) * n, 0);
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y) {
-      const uint8_t* row = &occ[(static_cast<size_t>(z) * n + y) * n];
-      if (std::find(row, row + n, uint8_t{1}) == row + n) continue;
-      row_near[static_cast<size_t>(z) * n + y] = 1;
-      int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
-      // Nearest obstacle at or left of each column, then at or right of it.
-      int last = -2 * n;
-      for (int x = 0; x < reach + kChunkSize; ++x) {
-        if (row[x]) last = x;
-        if (x >= reach) g[x - reach] = x - last;
-      }
-      int next = 3 * n;
-      for (int x = n - 1; x >= reach; --x) {
-        if (row[x]) next = x;
-        if (x < reach + kChunkSize) {
-          const int32_t d = std::min(g[x - reach], next - x);
-          g[x - reach] = std::min(cap2, d * d);
-        }
-      }
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const uint64_t m = rows[r];
+    if (m == 0) continue;
+    row_near[r] = 1;
+    int32_t* g = &gx[r * kChunkSize];
+    for (int i = 0; i < kChunkSize; ++i) {
+      const int c = reach + i;  // < n <= 64
+      const uint64_t low = m & (c >= 63 ? ~uint64_t{0} : (uint64_t{2} << c) - 1), high = m >> c;
+      const int left = low ? c - (63 - __builtin_clzll(low)) : 2 * n;
+      const int right = high ? __builtin_ctzll(high) : 2 * n;
+      const int32_t d = std::min(left, right);
+      g[i] = std::min(cap2, d * d);
     }
+  }
   // gy[z][j][i]: min over y of gx + (y - y_j)^2.
   std::vector<int32_t>& gy = fill_scratch_.gy;
   std::vector<uint8_t>& plane_near = fill_scratch_.plane_near;
@@ -208,11 +260,12 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
     for (int y = 0; y < n; ++y) {
       if (!row_near[static_cast<size_t>(z) * n + y]) continue;
       plane_near[static_cast<size_t>(z)] = 1;
-      const int32_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
+      const int32_t* __restrict g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
       for (int j = 0; j < kChunkSize; ++j) {
         const int32_t dy = y - (reach + j), q = dy * dy;
         if (q >= cap2) continue;
-        int32_t* out_row = &gy[(static_cast<size_t>(z) * kChunkSize + j) * kChunkSize];
+        // Restrict: the compiler vectorises the row only when it knows gx and gy apart.
+        int32_t* __restrict out_row = &gy[(static_cast<size_t>(z) * kChunkSize + j) * kChunkSize];
         for (int i = 0; i < kChunkSize; ++i) out_row[i] = std::min(out_row[i], g[i] + q);
       }
     }
@@ -222,11 +275,11 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   best.fill(cap2);
   for (int z = 0; z < n; ++z) {
     if (!plane_near[static_cast<size_t>(z)]) continue;
-    const int32_t* g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
+    const int32_t* __restrict g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
     for (int k = 0; k < kChunkSize; ++k) {
       const int32_t dz = z - (reach + k), q = dz * dz;
       if (q >= cap2) continue;
-      int32_t* b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
+      int32_t* __restrict b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
       for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], g[i] + q);
     }
   }

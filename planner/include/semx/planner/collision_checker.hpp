@@ -135,7 +135,8 @@ class CollisionChecker {
   };
   mutable std::array<LastChunk, 2> last_chunk_{};
   struct FillScratch {
-    std::vector<uint8_t> occ, row_near, plane_near;
+    std::vector<uint64_t> rows;  // obstacle bits per row of the region
+    std::vector<uint8_t> row_near, plane_near;
     std::vector<int32_t> gx, gy;
   };
   mutable FillScratch fill_scratch_;
