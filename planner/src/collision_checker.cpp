@@ -72,15 +72,20 @@ bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const V
                   y1 = std::min(kmax.y, base.y + map::kBlockMask) - base.y;
         const int z0 = std::max(kmin.z, base.z) - base.z,
                   z1 = std::min(kmax.z, base.z + map::kBlockMask) - base.z;
+        const uint32_t keep = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;
         for (int z = z0; z <= z1; ++z) {
           for (int y = y0; y <= y1; ++y) {
             if (!row_wanted(base.y + y, base.z + z)) continue;
-            const VoxelState* row =
-                b ? &b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) | (y << map::kBlockBits))]
-                  : nullptr;
-            for (int x = x0; x <= x1; ++x) {
-              const VoxelState st = row ? row[x] : VoxelState::kUnknown;
-              if (st == VoxelState::kFree || (st == VoxelState::kUnknown && !unknown_is_obstacle)) continue;
+            // The row's obstacles as bits (a block never allocated is all unknown), visited in
+            // order of x: a branch per voxel made the box checks a tenth of DEP's cycle.
+            uint32_t bits = (b ? obstacle_bits(&b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
+                                                                             (y << map::kBlockBits))],
+                                               unknown_is_obstacle)
+                               : 0xffffu) &
+                            keep;
+            while (bits) {
+              const int x = __builtin_ctz(bits);
+              bits &= bits - 1;
               if (!visit(base.x + x, base.y + y, base.z + z)) return false;
             }
           }
