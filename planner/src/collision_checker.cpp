@@ -96,6 +96,48 @@ bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const V
   return true;
 }
 
+// As for_each_obstacle, without row_wanted, but in the order of a loop over z, y, then x across
+// the blocks (a sum over the visits comes out the same to the last bit as that loop's); each row
+// of blocks is looked up once for all its voxel rows.
+template <class Visit>
+void for_each_obstacle_zyx(const map::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
+                           bool unknown_is_obstacle, Visit&& visit) {
+  const int32_t bx0 = map::block_of(kmin).x, bx1 = map::block_of(kmax).x;
+  std::vector<const map::VoxelBlock*> blocks(static_cast<size_t>(bx1 - bx0 + 1));
+  std::vector<uint32_t> keep(blocks.size());
+  for (int32_t bx = bx0; bx <= bx1; ++bx) {
+    const int base = bx * map::kBlockSize;
+    const int x0 = std::max(kmin.x, base) - base, x1 = std::min(kmax.x, base + map::kBlockMask) - base;
+    keep[static_cast<size_t>(bx - bx0)] = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;
+  }
+  int32_t row_by = 0, row_bz = 0;
+  bool looked = false;
+  for (int32_t z = kmin.z; z <= kmax.z; ++z)
+    for (int32_t y = kmin.y; y <= kmax.y; ++y) {
+      const int32_t by = y >> map::kBlockBits, bz = z >> map::kBlockBits;
+      if (!looked || by != row_by || bz != row_bz) {
+        for (int32_t bx = bx0; bx <= bx1; ++bx)
+          blocks[static_cast<size_t>(bx - bx0)] = grid.find_block({bx, by, bz});
+        row_by = by;
+        row_bz = bz;
+        looked = true;
+      }
+      const size_t row = static_cast<size_t>(((z & map::kBlockMask) << (2 * map::kBlockBits)) |
+                                             ((y & map::kBlockMask) << map::kBlockBits));
+      for (int32_t bx = bx0; bx <= bx1; ++bx) {
+        const map::VoxelBlock* b = blocks[static_cast<size_t>(bx - bx0)];
+        if (!b && !unknown_is_obstacle) continue;
+        uint32_t bits = (b ? obstacle_bits(&b->state[row], unknown_is_obstacle) : 0xffffu) &
+                        keep[static_cast<size_t>(bx - bx0)];
+        while (bits) {
+          const int x = __builtin_ctz(bits);
+          bits &= bits - 1;
+          visit(bx * map::kBlockSize + x, y, z);
+        }
+      }
+    }
+}
+
 // What changes whenever the grid does (changes() alone could repeat after a grid was replaced).
 std::array<uint64_t, 4> stamp_of(const map::StateGrid& g) {
   return {g.changes(), static_cast<uint64_t>(g.free_voxels()), static_cast<uint64_t>(g.occupied_voxels()),
@@ -407,18 +449,14 @@ bool CollisionChecker::centre(Eigen::Vector3d& p, int iterations, double max_ste
       kmax[i] = static_cast<int32_t>(std::ceil((p[i] + reach_[i]) * inv)) - 1;
     }
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
-    map::StateGrid::Reader reader = grid_->reader();
-    for (int32_t z = kmin.z; z <= kmax.z; ++z)
-      for (int32_t y = kmin.y; y <= kmax.y; ++y)
-        for (int32_t x = kmin.x; x <= kmax.x; ++x) {
-          if (reader.state({x, y, z}) == VoxelState::kFree) continue;
-          const Eigen::Vector3d lo(x * res, y * res, z * res);
-          const Eigen::Vector3d q = p.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
-          const Eigen::Vector3d v = p - q;
-          const double d = v.norm();
-          if (d >= r || d < 1e-9) continue;
-          push += (r - d) * v / d;
-        }
+    for_each_obstacle_zyx(*grid_, kmin, kmax, true, [&](int32_t x, int32_t y, int32_t z) {
+      const Eigen::Vector3d lo(x * res, y * res, z * res);
+      const Eigen::Vector3d q = p.cwiseMax(lo).cwiseMin(lo + Eigen::Vector3d::Constant(res));
+      const Eigen::Vector3d v = p - q;
+      const double d = v.norm();
+      if (d >= r || d < 1e-9) return;
+      push += (r - d) * v / d;
+    });
     const double n = push.norm();
     if (n < 1e-9) return false;  // inside an obstacle or pushed equally from all sides
     // How far to go along the push: where the ESDF value peaks within max_step. The summed push
