@@ -201,14 +201,21 @@ TEST(Processes, LauncherKilledHardTakesItsChildrenWithIt) {
   const std::string url = semx::runtime::udpm_url_for_port(test_port(3));
   const std::string out = temp_path("kill9.out");
   Process launcher({bin("semx-launch"), "foundation", "--lcm-url", url, "--no-color"}, out);
-  for (int i = 0; i < 100 && started_pids(read_file(out)).size() < 2; ++i) {
+  // Polled with deadlines, not fixed sleeps: on a loaded machine (ctest -j2 beside a bench) the
+  // set took longer than 5 s to start, or its children longer than 1.5 s to die.
+  for (int i = 0; i < 400 && started_pids(read_file(out)).size() < 2; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   const auto pids = started_pids(read_file(out));
-  ASSERT_EQ(pids.size(), 2u);
+  ASSERT_EQ(pids.size(), 2u) << read_file(out);
   launcher.signal(SIGKILL);
   launcher.wait(5);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  auto any_alive = [&] {
+    for (pid_t pid : pids)
+      if (pid_alive(pid)) return true;
+    return false;
+  };
+  for (int i = 0; i < 200 && any_alive(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   for (pid_t pid : pids) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " orphaned";
 }
 
