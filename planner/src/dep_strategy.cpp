@@ -817,7 +817,7 @@ Goal DepStrategy::tour_goal(PlanContext& ctx, const ScoreFn& score, int* stops) 
     core::Stopwatch w;
     for (int i = 1; i < n; ++i) {
       const int64_t a = sites[static_cast<size_t>(i - 1)];
-      const Roadmap::Search from = graph_.shortest_paths(a);
+      const Roadmap::Search from = graph_.shortest_paths(a, sites);
       ctx.counters->search_settled += from.settled;
       for (int j = 1; j < n; ++j) {
         if (i == j) continue;
@@ -941,7 +941,7 @@ Goal DepStrategy::pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& 
     const int64_t a = sites[static_cast<size_t>(i - 1)];
     at(0, i) = travel_time(search_.distance[static_cast<size_t>(a)], ctx.pose.yaw, yaw_of(a), config_.cost);
     at(i, k + 1) = travel_time(to_goal.distance[static_cast<size_t>(a)], yaw_of(a), far.yaw, config_.cost);
-    const Roadmap::Search from = graph_.shortest_paths(a);
+    const Roadmap::Search from = graph_.shortest_paths(a, sites);
     ctx.counters->search_settled += from.settled;
     for (int j = 1; j <= k; ++j) {
       const int64_t b = sites[static_cast<size_t>(j - 1)];

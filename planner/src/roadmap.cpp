@@ -142,11 +142,25 @@ bool Roadmap::any_within(const Eigen::Vector3d& p, double radius, int64_t exclud
   return false;
 }
 
-Roadmap::Search Roadmap::shortest_paths(int64_t source) const {
+Roadmap::Search Roadmap::shortest_paths(int64_t source) const { return shortest_paths(source, {}); }
+
+Roadmap::Search Roadmap::shortest_paths(int64_t source, const std::vector<int64_t>& targets) const {
   Search s;
   s.distance.assign(nodes_.size(), kInf);
   s.parent.assign(nodes_.size(), -1);
   if (!alive(source)) return s;
+  // Targets not yet settled (none: search everything).
+  std::vector<char> wanted;
+  int64_t left = 0;
+  if (!targets.empty()) {
+    wanted.assign(nodes_.size(), 0);
+    for (int64_t t : targets) {
+      if (!alive(t) || wanted[static_cast<size_t>(t)]) continue;
+      wanted[static_cast<size_t>(t)] = 1;
+      ++left;
+    }
+    if (left == 0) return s;
+  }
   using Item = std::pair<double, int64_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
   s.distance[static_cast<size_t>(source)] = 0.0;
@@ -156,6 +170,10 @@ Roadmap::Search Roadmap::shortest_paths(int64_t source) const {
     queue.pop();
     if (d > s.distance[static_cast<size_t>(id)]) continue;
     ++s.settled;
+    if (!wanted.empty() && wanted[static_cast<size_t>(id)]) {
+      wanted[static_cast<size_t>(id)] = 0;
+      if (--left == 0) break;
+    }
     for (const RoadmapEdge& e : node(id).edges) {
       const double nd = d + e.length;
       double& cur = s.distance[static_cast<size_t>(e.to)];

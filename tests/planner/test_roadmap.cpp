@@ -66,6 +66,34 @@ TEST(Roadmap, ShortestPaths) {
   EXPECT_EQ(s.settled, 4);
 }
 
+TEST(Roadmap, ShortestPathsToTargetsStopOnceTheyAreSettled) {
+  // A random graph: the targets' distances are the full search's, with fewer nodes settled when
+  // they lie near the source; an unreachable target leaves the whole component searched.
+  Roadmap g(1.0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 20.0);
+  for (int i = 0; i < 300; ++i) g.add_node({u(rng), u(rng), 1.0});
+  for (int i = 0; i < 299; ++i)
+    for (int j = i + 1; j < 300; ++j) {
+      const double d = (g.node(i).position - g.node(j).position).norm();
+      if (d < 2.0) g.add_edge(i, j, d);
+    }
+  const Roadmap::Search all = g.shortest_paths(0);
+  std::vector<int64_t> near;
+  for (int64_t id = 1; id < 300 && near.size() < 3; ++id)
+    if (all.reached(id) && all.distance[static_cast<size_t>(id)] < 4.0) near.push_back(id);
+  ASSERT_EQ(near.size(), 3u);
+  near.push_back(0);  // the source itself may be a target
+  const Roadmap::Search some = g.shortest_paths(0, near);
+  for (int64_t t : near) EXPECT_EQ(some.distance[static_cast<size_t>(t)], all.distance[static_cast<size_t>(t)]);
+  EXPECT_LT(some.settled, all.settled);
+  const int64_t lonely = g.add_node({100.0, 100.0, 1.0});
+  const Roadmap::Search none = g.shortest_paths(0, {near[0], lonely});
+  EXPECT_FALSE(none.reached(lonely));
+  EXPECT_EQ(none.settled, all.settled);
+  EXPECT_EQ(none.distance[static_cast<size_t>(near[0])], all.distance[static_cast<size_t>(near[0])]);
+}
+
 // A 6 x 4 x 2.5 m room, known entirely (walls occupied).
 map::StateGrid known_room() { return SyntheticWorld::room({6, 4, 2.5}, {1, 2, 1.2}).full_map(); }
 
