@@ -820,7 +820,14 @@ void Node::publish_status() {
 
 int Node::spin_once(int timeout_ms) {
   const auto now = std::chrono::steady_clock::now();
-  if (now >= next_status_) publish_status();
+  if (now >= next_status_) {
+    if (!stop_ && parent_watch_.parent_gone()) {
+      std::cerr << options_.name << ": the launcher that started it (pid " << parent_watch_.parent()
+                << ") is gone: stopping\n";
+      stop_ = true;
+    }
+    publish_status();
+  }
   const auto until_status = std::chrono::duration_cast<std::chrono::milliseconds>(next_status_ - now).count();
   const int wait = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, until_status)));
   if (udpm_) {

@@ -2,8 +2,10 @@
 // lcm::LogFile, a burst recorded whole, Ctrl-C leaving nothing behind, restart and failure policies, and a
 // node under a stream of hostile messages.
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 #include <lcm/lcm-cpp.hpp>
+#include <memory>
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/node_status_t.hpp>
@@ -84,9 +86,10 @@ TEST(Processes, LockstepSetIsRecordedAndReadBack) {
   while (const lcm::LogEvent* ev = file.readNextEvent()) {
     ++position;
     // The log keeps each message's trailer (docs/runtime.md, "Who may talk"); LCM reads before it.
-    const int n = static_cast<int>(
-        semx::runtime::payload_size(static_cast<const uint8_t*>(ev->data), static_cast<std::size_t>(ev->datalen)));
-    ASSERT_EQ(n + static_cast<int>(semx::runtime::kAuthTrailerBytes), ev->datalen) << ev->channel << " unsigned";
+    const int n = static_cast<int>(semx::runtime::payload_size(static_cast<const uint8_t*>(ev->data),
+                                                               static_cast<std::size_t>(ev->datalen)));
+    ASSERT_EQ(n + static_cast<int>(semx::runtime::kAuthTrailerBytes), ev->datalen)
+        << ev->channel << " unsigned";
     if (ev->channel == "SIM_CLOCK") {
       semx::clock_t c;
       ASSERT_EQ(c.decode(ev->data, 0, n), n);
@@ -219,6 +222,60 @@ TEST(Processes, LauncherKilledHardTakesItsChildrenWithIt) {
   for (pid_t pid : pids) EXPECT_FALSE(pid_alive(pid)) << "pid " << pid << " orphaned";
 }
 
+// A shell stands in for a launcher whose death signal was lost: it starts semx-clock in the
+// background (no PR_SET_PDEATHSIG), with or without the launcher's SEMX_SUPERVISOR_PID, and is
+// killed with SIGKILL. With the variable the clock stops by itself within a status period or two;
+// without it (a node started by hand) it goes on.
+namespace {
+pid_t orphan_clock(const std::string& url, bool supervised, const std::string& out, Process*& shell) {
+  const std::string env = supervised ? "SEMX_SUPERVISOR_PID=$$ " : "unset SEMX_SUPERVISOR_PID; ";
+  shell = new Process(
+      {"/bin/sh", "-c", env + bin("semx-clock") + " --lcm-url '" + url + "' & echo child=$!; wait"}, out);
+  pid_t child = -1;
+  for (int i = 0; i < 400; ++i) {
+    const std::string text = read_file(out);
+    const size_t at = text.find("child=");
+    if (at != std::string::npos && text.find("semx-clock: realtime") != std::string::npos) {
+      child = static_cast<pid_t>(std::stol(text.substr(at + 6)));
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return child;
+}
+}  // namespace
+
+TEST(Processes, ANodeWhoseLauncherIsGoneStopsWithoutTheDeathSignal) {
+  const std::string out = temp_path("orphan.out");
+  Process* shell = nullptr;
+  const pid_t child = orphan_clock(semx::runtime::udpm_url_for_port(test_port(8)), true, out, shell);
+  std::unique_ptr<Process> own(shell);
+  ASSERT_GT(child, 0) << read_file(out);
+  shell->signal(SIGKILL);
+  shell->wait(5);
+  for (int i = 0; i < 200 && pid_alive(child); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(pid_alive(child)) << read_file(out);
+  if (pid_alive(child)) kill(child, SIGKILL);
+  EXPECT_NE(read_file(out).find("is gone: stopping"), std::string::npos) << read_file(out);
+}
+
+TEST(Processes, ANodeStartedByHandOutlivesItsShell) {
+  const std::string out = temp_path("by-hand.out");
+  Process* shell = nullptr;
+  const pid_t child = orphan_clock(semx::runtime::udpm_url_for_port(test_port(8)), false, out, shell);
+  std::unique_ptr<Process> own(shell);
+  ASSERT_GT(child, 0) << read_file(out);
+  shell->signal(SIGKILL);
+  shell->wait(5);
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // two status periods and more
+  EXPECT_TRUE(pid_alive(child)) << read_file(out);
+  kill(child, SIGTERM);
+  for (int i = 0; i < 200 && pid_alive(child); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(pid_alive(child));
+}
+
 TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
   const std::string set = temp_path("fail.yaml");
   std::ofstream(set)
@@ -248,9 +305,9 @@ TEST(Processes, RestartsCountAndBackOff) {
   Process launcher({bin("semx-launch"), set, "--no-color"}, out);
   EXPECT_EQ(launcher.wait(20), 1);
   const std::string text = read_file(out);
-  for (const char* line : {"crashy | run=0", "crashy | run=1", "crashy | run=2", "crashy | run=3",
-                           "restart 1/3 in 0.10 s", "restart 2/3 in 0.20 s", "restart 3/3 in 0.40 s",
-                           "required process failed"}) {
+  for (const char* line :
+       {"crashy | run=0", "crashy | run=1", "crashy | run=2", "crashy | run=3", "restart 1/3 in 0.10 s",
+        "restart 2/3 in 0.20 s", "restart 3/3 in 0.40 s", "required process failed"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
   }
 }
@@ -260,11 +317,12 @@ TEST(Processes, RestartsCountAndBackOff) {
 TEST(Processes, AKilledLockstepNodeIsRespawnedAndTheClockWaitsForIt) {
   const std::string url = semx::runtime::udpm_url_for_port(test_port(9));
   const std::string set = temp_path("respawn.yaml");
-  std::ofstream(set) << "name: respawn\nprocesses:\n"
-                        "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
-                        "    restart: on-failure\n    restart_delay: 1.0\n"
-                        "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
-                        "--max-speed, \"2\"]\n    start_delay: 0.5\n";
+  std::ofstream(set)
+      << "name: respawn\nprocesses:\n"
+         "  - name: monitor\n    command: [semx-monitor, --lockstep, --status-period, \"0.2\"]\n"
+         "    restart: on-failure\n    restart_delay: 1.0\n"
+         "  - name: clock\n    command: [semx-clock, --mode, lockstep, --lockstep-nodes, monitor, "
+         "--max-speed, \"2\"]\n    start_delay: 0.5\n";
   const std::string out = temp_path("respawn.out");
   const std::string key = temp_path("respawn.key");
   std::filesystem::remove(key);
@@ -304,7 +362,7 @@ TEST(Processes, AKilledLockstepNodeIsRespawnedAndTheClockWaitsForIt) {
   EXPECT_GT(tick, stalled + 100) << "the clock goes on with the respawned node\n" << read_file(out);
   ASSERT_EQ(monitor_pids.size(), 2u) << read_file(out);
   EXPECT_EQ(monitor_pids.rbegin()->first == pids.front() ? monitor_pids.begin()->second
-                                                          : monitor_pids.rbegin()->second,
+                                                         : monitor_pids.rbegin()->second,
             1)
       << "the new process reports its restart";
   EXPECT_NE(read_file(out).find("monitor: restarted (pid"), std::string::npos) << read_file(out);
@@ -361,7 +419,8 @@ TEST(Processes, ChildrenGetTheResolvedLcmUrl) {
   const std::string out2 = temp_path("url2.out");
   Process launcher2({bin("semx-launch"), set, "--no-color", "--port-policy", "share"}, out2);
   EXPECT_EQ(launcher2.wait(20), 0);
-  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0&recv_buf_size=4194304."), std::string::npos)
+  EXPECT_NE(read_file(out2).find("url=udpm://239.255.76.67:7999?ttl=0&recv_buf_size=4194304."),
+            std::string::npos)
       << read_file(out2);
   if (saved)
     setenv("LCM_DEFAULT_URL", keep.c_str(), 1);
@@ -394,7 +453,8 @@ TEST(Processes, MissingProgramAndBadSetAreClearErrors) {
     const std::string out4 = temp_path(std::string("without_") + name + ".out");
     Process refused({bin("semx-launch"), two, "--without", name}, out4);
     EXPECT_EQ(refused.wait(10), 2);
-    EXPECT_NE(read_file(out4).find(std::string("--without '") + name + "'"), std::string::npos) << read_file(out4);
+    EXPECT_NE(read_file(out4).find(std::string("--without '") + name + "'"), std::string::npos)
+        << read_file(out4);
   }
 }
 
@@ -463,9 +523,8 @@ TEST(Processes, SemxRecordAndReplayRoundTrip) {
   // The dependency check and build come first (seconds on a loaded machine): wait for the
   // recorder's first heartbeat, which comes once it listens.
   bool listening = false;
-  node.subscribe<semx::node_status_t>("NODE_STATUS", [&](const semx::node_status_t& s) {
-    listening |= s.node == "logger";
-  });
+  node.subscribe<semx::node_status_t>("NODE_STATUS",
+                                      [&](const semx::node_status_t& s) { listening |= s.node == "logger"; });
   const auto ready_by = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (!listening && std::chrono::steady_clock::now() < ready_by) node.spin_once(50);
   ASSERT_TRUE(listening) << read_file(temp_path("record.out"));
@@ -555,7 +614,9 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   {
     semx::runtime::BusListeners readers(port, SEMX_BIN_DIR, /*max_hold_s=*/10.0, /*rescan_s=*/0.0);
     const auto start = std::chrono::steady_clock::now();
-    auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    auto wall = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
     int quiet = 0;  // in a row: one look can fall between a datagram's arrival and the wake-up
     while (quiet < 5 && wall() < 15) {
       quiet = readers.caught_up(wall()) ? quiet + 1 : 0;

@@ -21,6 +21,7 @@
 
 #include "semx/runtime/config.hpp"
 #include "semx/runtime/monotonic_clock.hpp"
+#include "semx/runtime/parent_watch.hpp"
 #include "semx/runtime/restart_count.hpp"
 
 namespace semx::tools {
@@ -246,6 +247,7 @@ class Supervisor {
         setenv(runtime::kEffectiveConfigEnv, (log_dir_ + "/" + c.spec->name + ".config.yaml").c_str(), 1);
       }
       setenv(runtime::kRestartEnv, std::to_string(c.restarts).c_str(), 1);
+      setenv(runtime::kSupervisorEnv, std::to_string(parent).c_str(), 1);
       for (const auto& [k, v] : c.spec->env) setenv(k.c_str(), v.c_str(), 1);
       std::vector<char*> argv;
       for (auto& a : argv_s) argv.push_back(a.data());

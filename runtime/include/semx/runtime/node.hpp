@@ -34,6 +34,7 @@
 #include "semx/runtime/delivery.hpp"
 #include "semx/runtime/lcm_schema.hpp"
 #include "semx/runtime/message_auth.hpp"
+#include "semx/runtime/parent_watch.hpp"
 #include "semx/runtime/restart_count.hpp"
 #include "semx/runtime/sim_clock.hpp"
 #include "semx/runtime/udpm_receiver.hpp"
@@ -350,6 +351,7 @@ class Node {
   std::map<std::string, ChannelCounters> incoming_;
   std::map<std::string, ChannelCounters> outgoing_;
   std::chrono::steady_clock::time_point next_status_;
+  ParentWatch parent_watch_;       // stops the node once the launcher that started it is gone
   std::size_t announcements_ = 0;  // statuses sent so far, up to the announce delays' count
   std::atomic<bool> stop_{false};
 };
