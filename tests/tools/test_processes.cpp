@@ -5,7 +5,6 @@
 
 #include <unistd.h>
 #include <lcm/lcm-cpp.hpp>
-#include <memory>
 #include <semx/ack_t.hpp>
 #include <semx/clock_t.hpp>
 #include <semx/node_status_t.hpp>
@@ -224,56 +223,54 @@ TEST(Processes, LauncherKilledHardTakesItsChildrenWithIt) {
 
 // A shell stands in for a launcher whose death signal was lost: it starts semx-clock in the
 // background (no PR_SET_PDEATHSIG), with or without the launcher's SEMX_SUPERVISOR_PID, and is
-// killed with SIGKILL. With the variable the clock stops by itself within a status period or two;
-// without it (a node started by hand) it goes on.
+// killed with SIGKILL once the clock runs. Returns the clock's pid (-1 when it never started).
+// With the variable the clock stops by itself within a status period or two; without it (a node
+// started by hand) it goes on.
 namespace {
-pid_t orphan_clock(const std::string& url, bool supervised, const std::string& out, Process*& shell) {
+pid_t orphan_clock(bool supervised, const std::string& out) {
+  const std::string url = semx::runtime::udpm_url_for_port(test_port(8));
   const std::string env = supervised ? "SEMX_SUPERVISOR_PID=$$ " : "unset SEMX_SUPERVISOR_PID; ";
-  shell = new Process(
-      {"/bin/sh", "-c", env + bin("semx-clock") + " --lcm-url '" + url + "' & echo child=$!; wait"}, out);
+  Process shell({"/bin/sh", "-c", env + bin("semx-clock") + " --lcm-url '" + url + "' & echo child=$!; wait"},
+                out);
   pid_t child = -1;
-  for (int i = 0; i < 400; ++i) {
+  for (int i = 0; i < 400 && child < 0; ++i) {
     const std::string text = read_file(out);
     const size_t at = text.find("child=");
     if (at != std::string::npos && text.find("semx-clock: realtime") != std::string::npos) {
       child = static_cast<pid_t>(std::stol(text.substr(at + 6)));
-      break;
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+  shell.signal(SIGKILL);
+  shell.wait(5);
   return child;
+}
+
+// Waits up to 10 s for pid to end; true when it did.
+bool ends(pid_t pid) {
+  for (int i = 0; i < 200 && pid_alive(pid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  return !pid_alive(pid);
 }
 }  // namespace
 
 TEST(Processes, ANodeWhoseLauncherIsGoneStopsWithoutTheDeathSignal) {
   const std::string out = temp_path("orphan.out");
-  Process* shell = nullptr;
-  const pid_t child = orphan_clock(semx::runtime::udpm_url_for_port(test_port(8)), true, out, shell);
-  std::unique_ptr<Process> own(shell);
+  const pid_t child = orphan_clock(true, out);
   ASSERT_GT(child, 0) << read_file(out);
-  shell->signal(SIGKILL);
-  shell->wait(5);
-  for (int i = 0; i < 200 && pid_alive(child); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  EXPECT_FALSE(pid_alive(child)) << read_file(out);
+  EXPECT_TRUE(ends(child)) << read_file(out);
   if (pid_alive(child)) kill(child, SIGKILL);
   EXPECT_NE(read_file(out).find("is gone: stopping"), std::string::npos) << read_file(out);
 }
 
 TEST(Processes, ANodeStartedByHandOutlivesItsShell) {
   const std::string out = temp_path("by-hand.out");
-  Process* shell = nullptr;
-  const pid_t child = orphan_clock(semx::runtime::udpm_url_for_port(test_port(8)), false, out, shell);
-  std::unique_ptr<Process> own(shell);
+  const pid_t child = orphan_clock(false, out);
   ASSERT_GT(child, 0) << read_file(out);
-  shell->signal(SIGKILL);
-  shell->wait(5);
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // two status periods and more
   EXPECT_TRUE(pid_alive(child)) << read_file(out);
   kill(child, SIGTERM);
-  for (int i = 0; i < 200 && pid_alive(child); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  EXPECT_FALSE(pid_alive(child));
+  EXPECT_TRUE(ends(child));
 }
 
 TEST(Processes, RestartPolicyThenRequiredFailureFailsTheSet) {
