@@ -34,6 +34,8 @@ static_assert(static_cast<uint8_t>(VoxelState::kUnknown) == 0 &&
               static_cast<uint8_t>(VoxelState::kFree) == 1 &&
               static_cast<uint8_t>(VoxelState::kOccupied) == 2 && sizeof(VoxelState) == 1);
 
+static_assert(map::kBlockSize == 16, "a block row is one 16-byte load");
+
 // The obstacles among a block row's 16 states as bits: every state but kFree when
 // unknown_is_obstacle, else kOccupied only.
 inline uint32_t obstacle_bits(const VoxelState* row, bool unknown_is_obstacle) {
@@ -52,12 +54,33 @@ inline uint32_t obstacle_bits(const VoxelState* row, bool unknown_is_obstacle) {
 #endif
 }
 
-// Calls visit(x, y, z) for every obstacle voxel (occupied; unknown too when unknown_is_obstacle,
-// including voxels of blocks never allocated) in the key box [kmin, kmax], block by block, and
-// skips the rows row_wanted(y, z) declines. Stops and returns false when visit returns false.
-template <class RowWanted, class Visit>
-bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
-                       bool unknown_is_obstacle, RowWanted&& row_wanted, Visit&& visit) {
+// The obstacles of row (y, z) of block b (block-local coordinates); a block never allocated is
+// all unknown.
+inline uint32_t row_obstacles(const map::VoxelBlock* b, int y, int z, bool unknown_is_obstacle) {
+  if (!b) return unknown_is_obstacle ? 0xffffu : 0u;
+  return obstacle_bits(&b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) | (y << map::kBlockBits))],
+                       unknown_is_obstacle);
+}
+
+// Bits x0..x1 of a block row.
+inline uint32_t span_bits(int x0, int x1) { return ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0; }
+
+// Calls f(x) for each set bit x, lowest first, while f returns true; false when it stopped.
+template <class F>
+bool each_bit(uint32_t bits, F&& f) {
+  for (; bits; bits &= bits - 1)
+    if (!f(__builtin_ctz(bits))) return false;
+  return true;
+}
+
+// Calls row(y, z, bits, x_base) for each block row of the key box [kmin, kmax] that row_wanted(y,
+// z) accepts, block by block: bits are its obstacles inside the box (occupied; unknown too when
+// unknown_is_obstacle, including voxels of blocks never allocated), bit i for voxel x_base + i.
+// With a branch per voxel the box checks were a tenth of DEP's cycle and the scan 30 % of an
+// ESDF chunk fill's instructions. Stops and returns false when row does.
+template <class RowWanted, class Row>
+bool for_each_obstacle_row(const map::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
+                           bool unknown_is_obstacle, RowWanted&& row_wanted, Row&& row) {
   const VoxelKey bmin = map::block_of(kmin), bmax = map::block_of(kmax);
   for (int32_t bz = bmin.z; bz <= bmax.z; ++bz) {
     for (int32_t by = bmin.y; by <= bmax.y; ++by) {
@@ -71,28 +94,29 @@ bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const V
                   y1 = std::min(kmax.y, base.y + map::kBlockMask) - base.y;
         const int z0 = std::max(kmin.z, base.z) - base.z,
                   z1 = std::min(kmax.z, base.z + map::kBlockMask) - base.z;
-        const uint32_t keep = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;
+        const uint32_t keep = span_bits(x0, x1);
         for (int z = z0; z <= z1; ++z) {
           for (int y = y0; y <= y1; ++y) {
             if (!row_wanted(base.y + y, base.z + z)) continue;
-            // The row's obstacles as bits (a block never allocated is all unknown), visited in
-            // order of x: a branch per voxel made the box checks a tenth of DEP's cycle.
-            uint32_t bits = (b ? obstacle_bits(&b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
-                                                                             (y << map::kBlockBits))],
-                                               unknown_is_obstacle)
-                               : 0xffffu) &
-                            keep;
-            while (bits) {
-              const int x = __builtin_ctz(bits);
-              bits &= bits - 1;
-              if (!visit(base.x + x, base.y + y, base.z + z)) return false;
-            }
+            const uint32_t bits = row_obstacles(b, y, z, unknown_is_obstacle) & keep;
+            if (bits && !row(base.y + y, base.z + z, bits, base.x)) return false;
           }
         }
       }
     }
   }
   return true;
+}
+
+// Calls visit(x, y, z) for every obstacle voxel of the key box (as above), block by block, in
+// order of x within a block row. Stops and returns false when visit returns false.
+template <class RowWanted, class Visit>
+bool for_each_obstacle(const map::StateGrid& grid, const VoxelKey& kmin, const VoxelKey& kmax,
+                       bool unknown_is_obstacle, RowWanted&& row_wanted, Visit&& visit) {
+  return for_each_obstacle_row(grid, kmin, kmax, unknown_is_obstacle, row_wanted,
+                               [&](int32_t y, int32_t z, uint32_t bits, int32_t x_base) {
+                                 return each_bit(bits, [&](int x) { return visit(x_base + x, y, z); });
+                               });
 }
 
 // As for_each_obstacle, without row_wanted, but in the order of a loop over z, y, then x across
@@ -106,8 +130,8 @@ void for_each_obstacle_zyx(const map::StateGrid& grid, const VoxelKey& kmin, con
   std::vector<uint32_t> keep(blocks.size());
   for (int32_t bx = bx0; bx <= bx1; ++bx) {
     const int base = bx * map::kBlockSize;
-    const int x0 = std::max(kmin.x, base) - base, x1 = std::min(kmax.x, base + map::kBlockMask) - base;
-    keep[static_cast<size_t>(bx - bx0)] = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;
+    keep[static_cast<size_t>(bx - bx0)] =
+        span_bits(std::max(kmin.x, base) - base, std::min(kmax.x, base + map::kBlockMask) - base);
   }
   int32_t row_by = 0, row_bz = 0;
   bool looked = false;
@@ -121,18 +145,14 @@ void for_each_obstacle_zyx(const map::StateGrid& grid, const VoxelKey& kmin, con
         row_bz = bz;
         looked = true;
       }
-      const size_t row = static_cast<size_t>(((z & map::kBlockMask) << (2 * map::kBlockBits)) |
-                                             ((y & map::kBlockMask) << map::kBlockBits));
       for (int32_t bx = bx0; bx <= bx1; ++bx) {
-        const map::VoxelBlock* b = blocks[static_cast<size_t>(bx - bx0)];
-        if (!b && !unknown_is_obstacle) continue;
-        uint32_t bits = (b ? obstacle_bits(&b->state[row], unknown_is_obstacle) : 0xffffu) &
-                        keep[static_cast<size_t>(bx - bx0)];
-        while (bits) {
-          const int x = __builtin_ctz(bits);
-          bits &= bits - 1;
+        const uint32_t bits = row_obstacles(blocks[static_cast<size_t>(bx - bx0)], y & map::kBlockMask,
+                                            z & map::kBlockMask, unknown_is_obstacle) &
+                              keep[static_cast<size_t>(bx - bx0)];
+        each_bit(bits, [&](int x) {
           visit(bx * map::kBlockSize + x, y, z);
-        }
+          return true;
+        });
       }
     }
 }
@@ -240,7 +260,6 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   // the states sixteen at a time; then each of the chunk's columns finds its nearest obstacle in
   // the row by counting bits. A byte per voxel, set by visiting the obstacles one by one and
   // scanned both ways per row, was 60 % of a fill's instructions.
-  static_assert(map::kBlockSize == 16, "a block row is one 16-byte load");
   if (n > 64) {  // rows wider than a mask (resolutions finer than ~3 cm): one search per centre
     for (int i = 0; i < kChunkVolume; ++i) {
       const VoxelKey c{chunk.x * kChunkSize + (i & kChunkMask),
@@ -252,31 +271,15 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   }
   std::vector<uint64_t>& rows = fill_scratch_.rows;
   rows.assign(static_cast<size_t>(n) * n, 0);
-  const VoxelKey hi{o.x + n - 1, o.y + n - 1, o.z + n - 1};
-  const VoxelKey bmin = map::block_of(o), bmax = map::block_of(hi);
-  for (int32_t bz = bmin.z; bz <= bmax.z; ++bz)
-    for (int32_t by = bmin.y; by <= bmax.y; ++by)
-      for (int32_t bx = bmin.x; bx <= bmax.x; ++bx) {
-        const map::VoxelBlock* b = grid_->find_block({bx, by, bz});
-        if (!b && !unknown_is_obstacle) continue;
-        const VoxelKey base{bx * map::kBlockSize, by * map::kBlockSize, bz * map::kBlockSize};
-        const int x0 = std::max(o.x, base.x) - base.x, x1 = std::min(hi.x, base.x + map::kBlockMask) - base.x;
-        const int y0 = std::max(o.y, base.y) - base.y, y1 = std::min(hi.y, base.y + map::kBlockMask) - base.y;
-        const int z0 = std::max(o.z, base.z) - base.z, z1 = std::min(hi.z, base.z + map::kBlockMask) - base.z;
-        const uint32_t keep = ((uint32_t{1} << (x1 - x0 + 1)) - 1) << x0;  // the row's part in the region
-        const int shift = base.x - o.x;                                    // block x to region x
-        for (int z = z0; z <= z1; ++z)
-          for (int y = y0; y <= y1; ++y) {
-            const uint32_t bits =
-                (b ? obstacle_bits(&b->state[static_cast<size_t>((z << (2 * map::kBlockBits)) |
-                                                                 (y << map::kBlockBits))],
-                                   unknown_is_obstacle)
-                   : 0xffffu) &
-                keep;
-            uint64_t& r = rows[static_cast<size_t>(base.z + z - o.z) * n + (base.y + y - o.y)];
-            r |= shift >= 0 ? static_cast<uint64_t>(bits) << shift : static_cast<uint64_t>(bits) >> -shift;
-          }
-      }
+  for_each_obstacle_row(
+      *grid_, o, {o.x + n - 1, o.y + n - 1, o.z + n - 1}, unknown_is_obstacle,
+      [](int32_t, int32_t) { return true; },
+      [&](int32_t y, int32_t z, uint32_t bits, int32_t x_base) {
+        const int shift = x_base - o.x;  // block x to region x
+        rows[static_cast<size_t>(z - o.z) * n + (y - o.y)] |=
+            shift >= 0 ? static_cast<uint64_t>(bits) << shift : static_cast<uint64_t>(bits) >> -shift;
+        return true;
+      });
   // gx[z][y][i]: squared x distance from the chunk's column i to the nearest obstacle of row (y, z).
   // Rows and planes with nothing below the cap are skipped by the later passes.
   std::vector<int32_t>& gx = fill_scratch_.gx;

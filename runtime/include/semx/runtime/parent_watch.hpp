@@ -4,8 +4,10 @@
 // the cause was not found). So the launcher also sets SEMX_SUPERVISOR_PID in each child's
 // environment, and a node that has it checks, with each NODE_STATUS, that its parent is still the
 // process that started it: when the parent dies, the kernel hands the child to another (init or
-// a subreaper), and the node stops. A node started by hand (no variable) is never stopped this
-// way: its shell may come and go (nohup).
+// a subreaper), and the node stops. The node compares with the parent it started with, not with
+// the variable's value (the launcher's pid, for whoever reads the environment), so a command the
+// launcher runs through a shell is watched too. A node started by hand (no variable) is never
+// stopped this way: its shell may come and go (nohup).
 #pragma once
 
 #include <sys/types.h>
