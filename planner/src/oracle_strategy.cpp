@@ -897,7 +897,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
         }
       }
     }
-    std::vector<uint32_t> stamp(m.targets.size(), 0);
     uint32_t gen = 0;
     std::vector<MaskedElement> tmp;
     auto view_of = [&](int g) -> const std::vector<MaskedElement>& {
@@ -909,28 +908,59 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     // to improve_evaluations times over the same legs, and walking a candidate's whole view (every
     // bin's voxels, cast again when the cache is full) for each of its samples was most of the
     // oracle's preparation (env3: 412 s). The counts, and so the orders chosen, are the same.
-    // They are kept up to a quarter of oracle.cache_mb, then listed again at each use.
-    std::unordered_map<int64_t, std::vector<int32_t>> bin_lists;
-    std::vector<int32_t> unkept;
+    // They are kept up to a quarter of oracle.cache_mb, then listed again at each use. A list is
+    // a sparse bitset over T's ids: T's ids follow the grid's x-rows, so a view's voxels share
+    // 64-bit words (16 to a word in g212, 164 m²) and the objective ORs and counts words, not ids.
+    struct Bits {
+      std::vector<uint32_t> word;  // ascending
+      std::vector<uint64_t> bits;  // of T ids 64 word .. 64 word + 63
+    };
+    std::unordered_map<int64_t, Bits> bin_lists;
+    Bits unkept;
+    std::vector<uint64_t> scratch((m.targets.size() + 63) / 64, 0);  // zero between uses
+    std::vector<uint32_t> words;
     size_t kept_bytes = 0;
     const size_t keep_budget = static_cast<size_t>(oc.cache_mb) << 18;
-    auto shown_by = [&](int g, int b) -> const std::vector<int32_t>& {
+    auto shown_by = [&](int g, int b) -> const Bits& {
       const int64_t key = static_cast<int64_t>(g) * bins + b;
       if (const auto it = bin_lists.find(key); it != bin_lists.end()) return it->second;
-      unkept.clear();
-      for (const MaskedElement& e : view_of(g))
-        if (e.members >> b & 1u) unkept.push_back(e.element);
-      if (kept_bytes + unkept.size() * sizeof(int32_t) > keep_budget) return unkept;
-      kept_bytes += unkept.size() * sizeof(int32_t);
-      return bin_lists.emplace(key, std::move(unkept)).first->second;
+      // The words are gathered in a scratch bitset and only they are sorted (a view lists its
+      // voxels in the order its rays met them).
+      words.clear();
+      for (const MaskedElement& e : view_of(g)) {
+        if (!(e.members >> b & 1u)) continue;
+        const uint32_t w = static_cast<uint32_t>(e.element) >> 6;
+        if (!scratch[w]) words.push_back(w);
+        scratch[w] |= uint64_t{1} << (e.element & 63);
+      }
+      std::sort(words.begin(), words.end());
+      unkept.word = words;
+      unkept.bits.resize(words.size());
+      for (size_t j = 0; j < words.size(); ++j) {
+        unkept.bits[j] = scratch[words[j]];
+        scratch[words[j]] = 0;
+      }
+      const size_t bytes = unkept.word.size() * (sizeof(uint32_t) + sizeof(uint64_t));
+      if (kept_bytes + bytes > keep_budget) return unkept;
+      kept_bytes += bytes;
+      return bin_lists.emplace(key, unkept).first->second;
     };
+    // What this objective's order has shown: word w of T's bitset, valid when word_gen[w] == gen.
+    std::vector<uint64_t> have_bits((m.targets.size() + 63) / 64, 0);
+    std::vector<uint32_t> word_gen(have_bits.size(), 0);
     const auto objective = [&](const std::vector<int>& order) {
       ++gen;
       int64_t have = 0;
       double early_at = std::numeric_limits<double>::infinity();
       auto show = [&](int g, int b, double t) {
-        for (const int32_t e : shown_by(g, b))
-          if (stamp[static_cast<size_t>(e)] != gen) stamp[static_cast<size_t>(e)] = gen, ++have;
+        const Bits& shown = shown_by(g, b);
+        for (size_t j = 0; j < shown.word.size(); ++j) {
+          const uint32_t w = shown.word[j];
+          const uint64_t had = word_gen[w] == gen ? have_bits[w] : 0;
+          have += __builtin_popcountll(shown.bits[j] & ~had);
+          have_bits[w] = had | shown.bits[j];
+          word_gen[w] = gen;
+        }
         if (have >= early && !(early_at < std::numeric_limits<double>::infinity())) early_at = t;
         return have >= target;
       };
