@@ -3,30 +3,9 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "semx/core/radix_sort.hpp"
+
 namespace semx::map {
-
-namespace {
-
-void radix_sort(std::vector<uint64_t>& packed, int bits) {
-  constexpr int kDigit = 11;
-  constexpr size_t kBuckets = size_t{1} << kDigit;
-  std::vector<size_t> count(kBuckets);
-  std::vector<uint64_t> other(packed.size());
-  for (int shift = 0; shift < bits; shift += kDigit) {
-    std::fill(count.begin(), count.end(), 0);
-    for (uint64_t p : packed) ++count[(p >> shift) & (kBuckets - 1)];
-    size_t sum = 0;
-    for (size_t& c : count) {
-      const size_t n = c;
-      c = sum;
-      sum += n;
-    }
-    for (uint64_t p : packed) other[count[(p >> shift) & (kBuckets - 1)]++] = p;
-    packed.swap(other);
-  }
-}
-
-}  // namespace
 
 void sort_unique(std::vector<VoxelKey>& keys) {
   if (keys.size() < 2) return;
@@ -56,14 +35,9 @@ void sort_unique(std::vector<VoxelKey>& keys) {
     packed[i] = (static_cast<uint64_t>(k.z - lo.z) << (bits[0] + bits[1])) |
                 (static_cast<uint64_t>(k.y - lo.y) << bits[0]) | static_cast<uint64_t>(k.x - lo.x);
   }
-  // Least significant digit first, 11 bits a pass: a map's keys need 2 or 3 passes, each linear
-  // (std::sort on the packings was still 6 % of FUEL's cycle). Short lists do not pay for the
-  // buckets.
-  if (packed.size() < 1024) {
-    std::sort(packed.begin(), packed.end());
-  } else {
-    radix_sort(packed, total);
-  }
+  // A map's keys need 2 or 3 radix passes, each linear (std::sort on the packings was still 6 %
+  // of FUEL's cycle).
+  core::radix_sort(packed, 0, total);
   packed.erase(std::unique(packed.begin(), packed.end()), packed.end());
   keys.resize(packed.size());
   const uint64_t mx = (uint64_t{1} << bits[0]) - 1, my = (uint64_t{1} << bits[1]) - 1;
