@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -10,6 +11,7 @@
 #include <unordered_set>
 
 #include "semx/core/angles.hpp"
+#include "semx/core/radix_heap.hpp"
 #include "semx/core/stopwatch.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/packed_elements.hpp"
@@ -73,6 +75,7 @@ struct OracleStrategy::Model {
   std::vector<float> move_cost;            // half the length: a move costs it times the two cells' factors
   mutable std::vector<float> search_cost;  // scratch of search()
   mutable std::vector<uint8_t> search_want;
+  mutable core::RadixHeap search_queue;
   map::StateGrid grid;  // the truth as a map (outside the box unknown: an obstacle)
   CollisionChecker checker;
   double cap = 0.6;  // clearances are exact up to this
@@ -352,15 +355,41 @@ void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<f
   const Eigen::Vector3d goal = target >= 0 ? centre(target) : Eigen::Vector3d::Zero();
   // A*'s heuristic: the straight distance, a lower bound (every factor is at least 1).
   auto h = [&](int64_t i) { return target >= 0 ? static_cast<float>((centre(i) - goal).norm()) : 0.0f; };
-  // Entries (cost + heuristic, cell); one whose cost is no longer the cell's is stale.
+  // Entries (cost + heuristic, cell); one whose cost is no longer the cell's is stale. Without a
+  // target (no heuristic) every entry pushed is above the one popped (moves cost > 0), so a radix
+  // heap serves: (cost, cell) as one 64-bit key (a non-negative float's bits keep its order) pops
+  // in the binary heap's order, ties by cell included, and the search settles every cell as before.
   using Entry = std::pair<float, int32_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  core::RadixHeap& radix = search_queue;
+  radix.clear();
+  const bool monotone = target < 0;
+  auto push = [&](float key, int32_t cell) {
+    if (!monotone) {
+      heap.emplace(key, cell);
+      return;
+    }
+    uint32_t bits;
+    std::memcpy(&bits, &key, sizeof bits);
+    radix.push(static_cast<uint64_t>(bits) << 32 | static_cast<uint32_t>(cell));
+  };
+  auto pop = [&]() -> Entry {
+    if (!monotone) {
+      const Entry e = heap.top();
+      heap.pop();
+      return e;
+    }
+    const uint64_t k = radix.pop();
+    const uint32_t bits = static_cast<uint32_t>(k >> 32);
+    float key;
+    std::memcpy(&key, &bits, sizeof key);
+    return {key, static_cast<int32_t>(static_cast<uint32_t>(k))};
+  };
   cost[static_cast<size_t>(source)] = 0.0f;
   length[static_cast<size_t>(source)] = 0.0f;
-  open.emplace(h(source), static_cast<int32_t>(source));
-  while (!open.empty()) {
-    const auto [key, i32] = open.top();
-    open.pop();
+  push(h(source), static_cast<int32_t>(source));
+  while (monotone ? !radix.empty() : !heap.empty()) {
+    const auto [key, i32] = pop();
     const int64_t i = i32;
     const size_t u = static_cast<size_t>(i);
     if (key > cost[u] + h(i) + 1e-4f) continue;  // stale
@@ -382,7 +411,7 @@ void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<f
         cost[v] = c;
         length[v] = lu + static_cast<float>(move_length[k]);
         if (parent) (*parent)[v] = i32;
-        open.emplace(c + h(static_cast<int64_t>(v)), static_cast<int32_t>(v));
+        push(c + h(static_cast<int64_t>(v)), static_cast<int32_t>(v));
       }
     }
   }
@@ -437,7 +466,8 @@ std::string OracleSummary::describe() const {
   if (first_pass_improved) s << " (sum " << first_pass_before_improvement << " s before reordering)";
   s << ") see " << 100.0 * cover_share() << " % of that (" << cover_dropped << " redundant dropped); tour "
     << tour_time << " s, " << tour_length << " m" << (tour_exact ? " (exact)" : " (heuristic)")
-    << "; prepared in " << prepare_ms / 1000.0 << " s";
+    << "; prepared in " << prepare_ms / 1000.0 << " s (" << casts << " views cast, " << views_kept
+    << " kept in " << static_cast<double>(view_bytes) / (1 << 20) << " MB of oracle.cache_mb)";
   return s.str();
 }
 
@@ -574,12 +604,15 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
           return;
         }
         m.cast(m.candidates[i], out);
+        ++summary_.casts;
         if (used + 3 * out.size() <= budget) {  // ~3 bytes a voxel: checked below
           PackedElements packed(out);
           if (used + packed.bytes() <= budget) {
             used += packed.bytes();
             cache[i] = std::move(packed);
             cached[i] = 1;
+            ++summary_.views_kept;
+            summary_.view_bytes = static_cast<int64_t>(used);
           }
         }
       },

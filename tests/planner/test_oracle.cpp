@@ -382,6 +382,38 @@ TEST(Oracle, OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
   }
 }
 
+TEST(Oracle, KeptOrCastAgainTheViewsGiveTheSamePlan) {
+  // The views kept packed (oracle.cache_mb) come back sorted, those cast again in the rays'
+  // order: the cover, the first pass and the tour must not tell them apart.
+  const SyntheticWorld world = tiny_world();
+  const SyntheticTruth truth(world);
+  PlannerConfig c = tiny_config();
+  c.oracle.cover_fraction = 0.9;
+  OracleStrategy kept(c);
+  kept.set_truth(&truth);
+  ASSERT_TRUE(kept.prepare(world.start(), 0.0)) << kept.summary().error;
+  c.oracle.cache_mb = 0;
+  OracleStrategy cast(c);
+  cast.set_truth(&truth);
+  ASSERT_TRUE(cast.prepare(world.start(), 0.0)) << cast.summary().error;
+  const OracleSummary &a = kept.summary(), &b = cast.summary();
+  EXPECT_EQ(a.views_kept, a.candidates);
+  EXPECT_EQ(a.casts, a.candidates) << "each view cast once when all are kept";
+  EXPECT_GT(a.view_bytes, 0);
+  EXPECT_EQ(b.views_kept, 0);
+  EXPECT_GT(b.casts, b.candidates);
+  EXPECT_EQ(a.observable, b.observable);
+  EXPECT_EQ(a.covered, b.covered);
+  EXPECT_EQ(a.first_pass, b.first_pass);
+  EXPECT_EQ(a.first_pass_target_time, b.first_pass_target_time);
+  EXPECT_EQ(a.tour_time, b.tour_time);
+  ASSERT_EQ(kept.tour().size(), cast.tour().size());
+  for (size_t i = 0; i < kept.tour().size(); ++i) {
+    EXPECT_TRUE(kept.tour()[i].position == cast.tour()[i].position) << i;
+    EXPECT_EQ(kept.tour()[i].yaw, cast.tour()[i].yaw) << i;
+  }
+}
+
 TEST(Oracle, PathsKeepTheClearanceOnTheTrueMapAndGoAroundWalls) {
   const SyntheticWorld world = SyntheticWorld::two_rooms();
   const SyntheticTruth truth(world);

@@ -65,6 +65,11 @@ struct OracleSummary {
   bool tour_exact = false;
   double prepare_ms = 0.0;  // wall time of the whole preparation (never charged: it stands for
                             // knowing the world beforehand)
+  // The candidates' views kept packed within oracle.cache_mb, their bytes, and the casts made:
+  // casts well above `candidates` say that a larger cache would prepare sooner.
+  int64_t views_kept = 0;
+  int64_t view_bytes = 0;
+  int64_t casts = 0;
   // observable / target, covered / observable.
   double observable_share() const { return target > 0 ? double(observable) / double(target) : 0.0; }
   double cover_share() const { return observable > 0 ? double(covered) / double(observable) : 0.0; }
