@@ -38,8 +38,18 @@ PackedElements::PackedElements(std::vector<MaskedElement> elements) : count_(ele
     keys[i] = static_cast<uint64_t>(elements[i].element) << 32 | elements[i].members;
   }
   core::radix_sort(keys, 32, 63);
-  data_.reserve(3 * keys.size());
+  // The exact size first: a kept view's memory is its capacity, and thousands are kept.
+  size_t bytes = 0;
   int64_t previous = -1;
+  for (const uint64_t k : keys) {
+    const int64_t e = static_cast<int64_t>(k >> 32);
+    for (uint64_t gap = static_cast<uint64_t>(e - previous - 1); gap >= 0x80; gap >>= 7) ++bytes;
+    previous = e;
+    int start = 0, length = 0;
+    bytes += one_run(static_cast<uint32_t>(k), start, length) ? 3 : 6;
+  }
+  data_.reserve(bytes);
+  previous = -1;
   for (const uint64_t k : keys) {
     const int64_t e = static_cast<int64_t>(k >> 32);
     if (e == previous) throw std::invalid_argument("PackedElements: repeated element");
