@@ -6,6 +6,7 @@
 #include <bitset>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 
@@ -316,14 +317,30 @@ PlannerConfig tiny_config() {
 
 // A share below 1: a full cover of this room needs every (candidate, yaw) set (each holds a few
 // voxels of floor or wall no other does), and a tour through all of them is beyond brute force.
+// The tiny world's config with a 90 % cover, so that brute force over its sets stays small.
+PlannerConfig cover_config() {
+  PlannerConfig c = tiny_config();
+  c.oracle.cover_fraction = 0.9;
+  return c;
+}
+
+// An oracle on `truth` with config c, prepared from the world's start (the summary says whether
+// that worked).
+std::unique_ptr<OracleStrategy> prepared_oracle(const SyntheticWorld& world, const SyntheticTruth& truth,
+                                                const PlannerConfig& c) {
+  auto oracle = std::make_unique<OracleStrategy>(c);
+  oracle->set_truth(&truth);
+  oracle->prepare(world.start(), 0.0);
+  return oracle;
+}
+
 TEST(Oracle, OnATinyWorldTheCoverAndTheTourAreWhatBruteForceFinds) {
   const SyntheticWorld world = tiny_world();
   const SyntheticTruth truth(world);
-  PlannerConfig c = tiny_config();
-  c.oracle.cover_fraction = 0.9;
-  OracleStrategy oracle(c);
-  oracle.set_truth(&truth);
-  ASSERT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
+  const PlannerConfig c = cover_config();
+  const auto prepared = prepared_oracle(world, truth, c);
+  OracleStrategy& oracle = *prepared;
+  ASSERT_TRUE(oracle.summary().ready) << oracle.summary().error;
   const std::vector<Eigen::Vector3d> cand = oracle.candidates();
   ASSERT_GE(cand.size(), 4u);
   ASSERT_LE(cand.size(), 9u);
@@ -387,15 +404,13 @@ TEST(Oracle, KeptOrCastAgainTheViewsGiveTheSamePlan) {
   // order: the cover, the first pass and the tour must not tell them apart.
   const SyntheticWorld world = tiny_world();
   const SyntheticTruth truth(world);
-  PlannerConfig c = tiny_config();
-  c.oracle.cover_fraction = 0.9;
-  OracleStrategy kept(c);
-  kept.set_truth(&truth);
-  ASSERT_TRUE(kept.prepare(world.start(), 0.0)) << kept.summary().error;
+  PlannerConfig c = cover_config();
+  const auto kept_oracle = prepared_oracle(world, truth, c);
   c.oracle.cache_mb = 0;
-  OracleStrategy cast(c);
-  cast.set_truth(&truth);
-  ASSERT_TRUE(cast.prepare(world.start(), 0.0)) << cast.summary().error;
+  const auto cast_oracle = prepared_oracle(world, truth, c);
+  const OracleStrategy &kept = *kept_oracle, &cast = *cast_oracle;
+  ASSERT_TRUE(kept.summary().ready) << kept.summary().error;
+  ASSERT_TRUE(cast.summary().ready) << cast.summary().error;
   const OracleSummary &a = kept.summary(), &b = cast.summary();
   EXPECT_EQ(a.views_kept, a.candidates);
   EXPECT_EQ(a.casts, a.candidates) << "each view cast once when all are kept";
