@@ -605,7 +605,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
         }
         m.cast(m.candidates[i], out);
         ++summary_.casts;
-        if (used + 3 * out.size() <= budget) {  // ~3 bytes a voxel: checked below
+        if (used + 3 * out.size() <= budget) {  // a packed voxel takes 3 bytes at least
           PackedElements packed(out);
           if (used + packed.bytes() <= budget) {
             used += packed.bytes();
@@ -938,11 +938,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       }
     }
     uint32_t gen = 0;
-    std::vector<MaskedElement> tmp;
-    auto view_of = [&](int g) -> const std::vector<MaskedElement>& {
-      source.elements(g, tmp);
-      return tmp;
-    };
+    std::vector<MaskedElement> view;
     // The T voxels view (g, b) shows, listed once per improvement: the objective below runs up
     // to improve_evaluations times over the same legs, and walking a candidate's whole view (every
     // bin's voxels, cast again when the cache is full) for each of its samples was most of the
@@ -957,7 +953,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     std::unordered_map<int64_t, Bits> bin_lists;
     Bits unkept;
     std::vector<uint64_t> scratch((m.targets.size() + 63) / 64, 0);  // zero between uses
-    std::vector<uint32_t> words;
     size_t kept_bytes = 0;
     const size_t keep_budget = static_cast<size_t>(oc.cache_mb) << 18;
     auto shown_by = [&](int g, int b) -> const Bits& {
@@ -965,24 +960,25 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       if (const auto it = bin_lists.find(key); it != bin_lists.end()) return it->second;
       // The words are gathered in a scratch bitset and only they are sorted (a view lists its
       // voxels in the order its rays met them).
+      source.elements(g, view);
+      std::vector<uint32_t>& words = unkept.word;
       words.clear();
-      for (const MaskedElement& e : view_of(g)) {
+      for (const MaskedElement& e : view) {
         if (!(e.members >> b & 1u)) continue;
         const uint32_t w = static_cast<uint32_t>(e.element) >> 6;
         if (!scratch[w]) words.push_back(w);
         scratch[w] |= uint64_t{1} << (e.element & 63);
       }
       std::sort(words.begin(), words.end());
-      unkept.word = words;
       unkept.bits.resize(words.size());
       for (size_t j = 0; j < words.size(); ++j) {
         unkept.bits[j] = scratch[words[j]];
         scratch[words[j]] = 0;
       }
-      const size_t bytes = unkept.word.size() * (sizeof(uint32_t) + sizeof(uint64_t));
+      const size_t bytes = words.size() * (sizeof(uint32_t) + sizeof(uint64_t));
       if (kept_bytes + bytes > keep_budget) return unkept;
       kept_bytes += bytes;
-      return bin_lists.emplace(key, unkept).first->second;
+      return bin_lists.emplace(key, std::move(unkept)).first->second;
     };
     // What this objective's order has shown: word w of T's bitset, valid when word_gen[w] == gen.
     std::vector<uint64_t> have_bits((m.targets.size() + 63) / 64, 0);

@@ -30,7 +30,7 @@ bool one_run(uint32_t m, int& start, int& length) {
 
 }  // namespace
 
-PackedElements::PackedElements(std::vector<MaskedElement> elements) : count_(elements.size()) {
+PackedElements::PackedElements(const std::vector<MaskedElement>& elements) : count_(elements.size()) {
   // Sorted by element through 64-bit packings (element above, mask below).
   std::vector<uint64_t> keys(elements.size());
   for (size_t i = 0; i < elements.size(); ++i) {
@@ -38,36 +38,33 @@ PackedElements::PackedElements(std::vector<MaskedElement> elements) : count_(ele
     keys[i] = static_cast<uint64_t>(elements[i].element) << 32 | elements[i].members;
   }
   core::radix_sort(keys, 32, 63);
-  // The exact size first: a kept view's memory is its capacity, and thousands are kept.
+  // One encoder, run twice: counting the bytes, then writing them into a buffer of that exact
+  // size (a kept view's memory is its capacity, and thousands are kept).
+  auto encode = [&](auto&& put) {
+    int64_t previous = -1;
+    for (const uint64_t k : keys) {
+      const int64_t e = static_cast<int64_t>(k >> 32);
+      if (e == previous) throw std::invalid_argument("PackedElements: repeated element");
+      for (uint64_t gap = static_cast<uint64_t>(e - previous - 1);; gap >>= 7) {
+        put(static_cast<uint8_t>((gap & 0x7f) | (gap >= 0x80 ? 0x80 : 0)));
+        if (gap < 0x80) break;
+      }
+      previous = e;
+      const uint32_t m = static_cast<uint32_t>(k);
+      int start = 0, length = 0;
+      if (one_run(m, start, length)) {
+        put(static_cast<uint8_t>(start));
+        put(static_cast<uint8_t>(length));
+      } else {
+        put(kRawMask);
+        for (int b = 0; b < 4; ++b) put(static_cast<uint8_t>(m >> (8 * b)));
+      }
+    }
+  };
   size_t bytes = 0;
-  int64_t previous = -1;
-  for (const uint64_t k : keys) {
-    const int64_t e = static_cast<int64_t>(k >> 32);
-    for (uint64_t gap = static_cast<uint64_t>(e - previous - 1); gap >= 0x80; gap >>= 7) ++bytes;
-    previous = e;
-    int start = 0, length = 0;
-    bytes += one_run(static_cast<uint32_t>(k), start, length) ? 3 : 6;
-  }
+  encode([&](uint8_t) { ++bytes; });
   data_.reserve(bytes);
-  previous = -1;
-  for (const uint64_t k : keys) {
-    const int64_t e = static_cast<int64_t>(k >> 32);
-    if (e == previous) throw std::invalid_argument("PackedElements: repeated element");
-    for (uint64_t gap = static_cast<uint64_t>(e - previous - 1);; gap >>= 7) {
-      data_.push_back(static_cast<uint8_t>((gap & 0x7f) | (gap >= 0x80 ? 0x80 : 0)));
-      if (gap < 0x80) break;
-    }
-    previous = e;
-    const uint32_t m = static_cast<uint32_t>(k);
-    int start = 0, length = 0;
-    if (one_run(m, start, length)) {
-      data_.push_back(static_cast<uint8_t>(start));
-      data_.push_back(static_cast<uint8_t>(length));
-    } else {
-      data_.push_back(kRawMask);
-      for (int b = 0; b < 4; ++b) data_.push_back(static_cast<uint8_t>(m >> (8 * b)));
-    }
-  }
+  encode([&](uint8_t b) { data_.push_back(b); });
 }
 
 void PackedElements::unpack(std::vector<MaskedElement>& out) const {

@@ -18,7 +18,7 @@ class PackedElements {
  public:
   PackedElements() = default;
   // Elements must be distinct and non-negative; their order does not matter (they are sorted).
-  explicit PackedElements(std::vector<MaskedElement> elements);
+  explicit PackedElements(const std::vector<MaskedElement>& elements);
 
   // The elements in ascending order.
   void unpack(std::vector<MaskedElement>& out) const;

@@ -437,7 +437,7 @@ struct OracleConfig {
   // candidate in the 600 m² generated world, 1.9 GB for its 7072), and a quarter of it again for
   // the first pass's per-yaw lists: the set cover asks for a candidate's view again whenever one of
   // its bounds comes first, and beyond this a view is cast again each time (slower, the same
-  // result; the oracle's summary line counts the casts). 2048 holds every world of the bench.
+  // result; the oracle's summary line counts the casts). 2048 holds g224's views (600 m²).
   int cache_mb = 2048;
 };
 
