@@ -237,6 +237,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   sf.get("start_turns", c.semantic_fuel.start_turns, 0, 16);
   sf.get("doorway_first_cost", c.semantic_fuel.doorway_first_cost, 0.0, 1e6);
   sf.get("doorway_radius", c.semantic_fuel.doorway_radius, 0.0, 10.0);
+  sf.get("door_clusters", c.semantic_fuel.door_clusters);
   sf.get("dep_first_s", c.semantic_fuel.dep_first_s, 0.0, 1e6);
 }
 

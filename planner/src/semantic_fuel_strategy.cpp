@@ -47,6 +47,16 @@ bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<Semantic
   return false;
 }
 
+bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius) {
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  for (const SemanticRegion& r : regions) {
+    if (r.class_id == door && r.centroid.allFinite() &&
+        (p - r.centroid).head<2>().squaredNorm() <= radius * radius)
+      return true;
+  }
+  return false;
+}
+
 void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem) {
   const size_t n = static_cast<size_t>(problem.n);
   auto of = [&](size_t node) { return node == 0 ? -1 : room[node - 1]; };
@@ -70,16 +80,9 @@ void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSear
                                           TourProblem& problem) const {
   if (!ctx.regions || ctx.regions->empty()) return;
   if (rules_.doorway_first_cost > 0) {
-    const int door = static_cast<int>(runtime::SemanticClass::kDoor);
     std::vector<bool> doorway(means.size(), false);
-    const double r2 = rules_.doorway_radius * rules_.doorway_radius;
-    for (size_t i = 0; i < means.size(); ++i) {
-      for (const SemanticRegion& r : *ctx.regions) {
-        if (r.class_id == door && r.centroid.allFinite() &&
-            (means[i] - r.centroid).head<2>().squaredNorm() <= r2)
-          doorway[i] = true;
-      }
-    }
+    for (size_t i = 0; i < means.size(); ++i)
+      doorway[i] = near_door(means[i], *ctx.regions, rules_.doorway_radius);
     add_doorway_first_cost(doorway, rules_.doorway_first_cost, problem);
   }
   if (!(rules_.door_cost > 0)) return;
@@ -95,7 +98,9 @@ void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSear
 namespace semx::planner {
 
 bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const {
-  if (!rules_.object_pockets || !ctx.regions) return false;
+  if (!ctx.regions) return false;
+  if (rules_.door_clusters && near_door(cluster.mean, *ctx.regions, rules_.doorway_radius)) return true;
+  if (!rules_.object_pockets) return false;
   if (rules_.object_reach > 0 && (cluster.mean - ctx.pose.position).norm() > rules_.object_reach)
     return false;
   return near_unfinished_object(cluster.mean, *ctx.regions, rules_.object_margin);

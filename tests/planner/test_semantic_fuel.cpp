@@ -93,6 +93,61 @@ TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
   }
 }
 
+// A door region: its centroid (the open leaf's) at `at`.
+SemanticRegion door_at(const Eigen::Vector3d& at) {
+  SemanticRegion r;
+  r.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
+  r.centroid = at;
+  r.extent = Eigen::Vector3d(0.05, 0.9, 2.0);
+  r.weight = 300.0;
+  r.radius = 3.0;
+  r.active = true;
+  return r;
+}
+
+TEST(SemanticFuel, ASmallClusterAtADoorIsTouredWithTheLargeOnes) {
+  // The pocket stands for a doorway's small frontier: a door region 1 m from it.
+  PocketScene s;
+  s.regions = {door_at({1.0, 3.6, 1.0})};
+  s.config.semantic_fuel.object_pockets = false;
+  s.config.semantic_fuel.door_clusters = true;
+  SemanticFuelStrategy sem(s.config);
+  const Eigen::Vector3d g = s.first_site(sem);
+  EXPECT_TRUE(s.at_pocket(g)) << g.transpose();
+}
+
+TEST(SemanticFuel, WithoutADoorAtTheSmallClusterItFliesFuelsTour) {
+  PocketScene base;
+  FuelStrategy fuel(base.config);
+  const Eigen::Vector3d f = base.first_site(fuel);
+  EXPECT_GT(f.x(), 4.2) << "the scene is meant to make FUEL leave the pocket for later";
+  auto first = [](PocketScene& s) {
+    s.config.semantic_fuel.object_pockets = false;
+    SemanticFuelStrategy sem(s.config);
+    return s.first_site(sem);
+  };
+  {  // the door is the doorway's, 3.9 m from the pocket
+    PocketScene s;
+    s.config.semantic_fuel.door_clusters = true;
+    s.regions = {door_at({4.2, 1.2, 1.0})};
+    EXPECT_EQ(first(s), f);
+  }
+  {  // a door at the pocket, the rule off
+    PocketScene s;
+    s.regions = {door_at({1.0, 3.6, 1.0})};
+    EXPECT_EQ(first(s), f);
+  }
+}
+
+TEST(SemanticFuel, NearADoorIsWithinTheRadiusHorizontally) {
+  const std::vector<SemanticRegion> doors{door_at({2.0, 0.0, 1.0})};
+  EXPECT_TRUE(near_door({3.4, 0.0, 2.4}, doors, 1.5));  // height does not count
+  EXPECT_FALSE(near_door({3.6, 0.0, 1.0}, doors, 1.5));
+  SemanticRegion chair = door_at({2.0, 0.0, 1.0});
+  chair.class_id = static_cast<int>(runtime::SemanticClass::kChair);
+  EXPECT_FALSE(near_door({2.0, 0.0, 1.0}, {chair}, 1.5)) << "only doors";
+}
+
 TEST(SemanticFuel, StartTurnsLookAroundBeforeTheFirstTour) {
   PocketScene s;
   s.config.semantic_fuel.start_turns = 3;

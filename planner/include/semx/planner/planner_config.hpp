@@ -219,6 +219,10 @@ struct SemanticFuelConfig {
   // finishes what is around it. 0: off.
   double doorway_first_cost = 0.0;
   double doorway_radius = 1.5;  // m
+  // Doorway clusters: a frontier cluster too small for FUEL's tour whose mean lies within
+  // doorway_radius of a door region is toured with the large ones: a doorway's frontier is small,
+  // the room behind it is not. false: FUEL's order.
+  bool door_clusters = false;
   // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
   // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
   double dep_first_s = 0.0;

@@ -60,6 +60,9 @@ std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& pat
 bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
                             double margin);
 
+// Whether `p` lies within `radius` (horizontally) of a door region's centroid.
+bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius);
+
 // Adds `cost` to the first leg (from the vehicle, node 0) into every site that is not a doorway's
 // while any site is (`doorway[i]` is node i + 1's): the tour starts with a doorway.
 void add_doorway_first_cost(const std::vector<bool>& doorway, double cost, TourProblem& problem);
