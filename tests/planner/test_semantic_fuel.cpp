@@ -12,6 +12,19 @@
 namespace semx::planner {
 namespace {
 
+// A region of class `c` (weight 300, radius 3 m) whose box is `extent` around `centroid`.
+SemanticRegion region(runtime::SemanticClass c, const Eigen::Vector3d& centroid,
+                      const Eigen::Vector3d& extent, bool active = true) {
+  SemanticRegion r;
+  r.class_id = static_cast<int>(c);
+  r.centroid = centroid;
+  r.extent = extent;
+  r.weight = 300.0;
+  r.radius = 3.0;
+  r.active = active;
+  return r;
+}
+
 // SyntheticWorld::two_rooms (x 0-4 and 4.2-8.2, y 0-4, a doorway at y 1.4-2.6): the first room is
 // known but for a small pocket on a cabinet in its corner (a frontier cluster below FUEL's size
 // threshold), the second only its first 1.5 m. The vehicle stands in the first room, nearer the
@@ -27,14 +40,7 @@ struct PocketScene : PlanScene {
   }
   // The cabinet whose top holds the pocket.
   SemanticRegion cabinet(bool active = true) const {
-    SemanticRegion r;
-    r.class_id = static_cast<int>(runtime::SemanticClass::kCabinet);
-    r.centroid = Eigen::Vector3d(0.25, 3.75, 0.5);
-    r.extent = Eigen::Vector3d(0.5, 0.5, 1.0);
-    r.weight = 300.0;
-    r.radius = 3.0;
-    r.active = active;
-    return r;
+    return region(runtime::SemanticClass::kCabinet, {0.25, 3.75, 0.5}, {0.5, 0.5, 1.0}, active);
   }
   // The first cluster of the plan's tour: its mean.
   Eigen::Vector3d first_site(FuelStrategy& s) {
@@ -46,14 +52,18 @@ struct PocketScene : PlanScene {
     return s.clusters().find(s.tour().front())->mean;
   }
   bool at_pocket(const Eigen::Vector3d& p) const { return (p - pocket).norm() < 0.6; }
+  // FUEL's first site here: beyond the doorway, the pocket left for later.
+  static Eigen::Vector3d fuel_first_site() {
+    PocketScene s;
+    FuelStrategy fuel(s.config);
+    const Eigen::Vector3d f = s.first_site(fuel);
+    EXPECT_GT(f.x(), 4.2) << "the scene is meant to make FUEL leave the pocket for later";
+    return f;
+  }
 };
 
 TEST(SemanticFuel, APocketAtAnUnfinishedObjectIsToured) {
-  PocketScene s;
-  s.regions = {s.cabinet()};
-  FuelStrategy fuel(s.config);
-  const Eigen::Vector3d f = s.first_site(fuel);
-  EXPECT_GT(f.x(), 4.2) << "the scene is meant to make FUEL leave the pocket for later";
+  PocketScene::fuel_first_site();
   PocketScene t;
   t.regions = {t.cabinet()};
   SemanticFuelStrategy sem(t.config);
@@ -62,9 +72,7 @@ TEST(SemanticFuel, APocketAtAnUnfinishedObjectIsToured) {
 }
 
 TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
-  PocketScene base;
-  FuelStrategy fuel(base.config);
-  const Eigen::Vector3d f = base.first_site(fuel);
+  const Eigen::Vector3d f = PocketScene::fuel_first_site();
   auto first = [](PocketScene& s) {
     SemanticFuelStrategy sem(s.config);
     return s.first_site(sem);
@@ -95,16 +103,8 @@ TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
 
 // A door region: its centroid (the open leaf's) at `at`.
 SemanticRegion door_at(const Eigen::Vector3d& at) {
-  SemanticRegion r;
-  r.class_id = static_cast<int>(runtime::SemanticClass::kDoor);
-  r.centroid = at;
-  r.extent = Eigen::Vector3d(0.05, 0.9, 2.0);
-  r.weight = 300.0;
-  r.radius = 3.0;
-  r.active = true;
-  return r;
+  return region(runtime::SemanticClass::kDoor, at, {0.05, 0.9, 2.0});
 }
-
 TEST(SemanticFuel, ASmallClusterAtADoorIsTouredWithTheLargeOnes) {
   // The pocket stands for a doorway's small frontier: a door region 1 m from it.
   PocketScene s;
@@ -117,10 +117,7 @@ TEST(SemanticFuel, ASmallClusterAtADoorIsTouredWithTheLargeOnes) {
 }
 
 TEST(SemanticFuel, WithoutADoorAtTheSmallClusterItFliesFuelsTour) {
-  PocketScene base;
-  FuelStrategy fuel(base.config);
-  const Eigen::Vector3d f = base.first_site(fuel);
-  EXPECT_GT(f.x(), 4.2) << "the scene is meant to make FUEL leave the pocket for later";
+  const Eigen::Vector3d f = PocketScene::fuel_first_site();
   auto first = [](PocketScene& s) {
     s.config.semantic_fuel.object_pockets = false;
     SemanticFuelStrategy sem(s.config);
