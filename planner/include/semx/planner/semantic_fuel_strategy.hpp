@@ -8,7 +8,11 @@
 //  - rooms (door_cost, off: it lost): a door region is where one room ends; every tour leg from one
 //    room to another costs door_cost seconds more, so the tour changes room as few times as it
 //    can. A site's room is the last door its coarse path from the vehicle passes (door_rooms());
-//    sites whose path passes no door are in the vehicle's room.
+//    sites whose path passes no door are in the vehicle's room;
+//  - doorway clusters (door_clusters, off: it lost): a small cluster within doorway_radius of a
+//    door region is toured with the large ones, as a pocket is: a doorway's frontier is small, the
+//    room behind it is not;
+//  - and doorways first, start turns, DEP first (SemanticFuelConfig says what each does).
 // Everything else is FUEL's, unchanged.
 #pragma once
 
