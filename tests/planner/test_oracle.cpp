@@ -315,9 +315,9 @@ PlannerConfig tiny_config() {
   return c;
 }
 
-// A share below 1: a full cover of this room needs every (candidate, yaw) set (each holds a few
-// voxels of floor or wall no other does), and a tour through all of them is beyond brute force.
-// The tiny world's config with a 90 % cover, so that brute force over its sets stays small.
+// The tiny world's config with a 90 % cover: a full cover of this room needs every (candidate,
+// yaw) set (each holds a few voxels of floor or wall no other does), and a tour through all of
+// them is beyond brute force.
 PlannerConfig cover_config() {
   PlannerConfig c = tiny_config();
   c.oracle.cover_fraction = 0.9;
