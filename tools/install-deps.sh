@@ -30,8 +30,10 @@ ros_packages=(
 )
 [ "${SEMX_NO_ROS:-0}" = 1 ] || packages+=("${ros_packages[@]}")
 
-# One dpkg-query for all of them: every ./semx command runs this first.
-installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null | awk '/ install ok installed$/ {print $1}')
+# One dpkg-query for all of them: every ./semx command runs this first. It exits 1 when dpkg has
+# never heard of one of them (a fresh machine), which must not end the script under pipefail.
+installed=$({ dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null || true; } |
+  awk '/ install ok installed$/ {print $1}')
 missing=()
 for p in "${packages[@]}"; do
   grep -qxF "$p" <<<"$installed" || missing+=("$p")
