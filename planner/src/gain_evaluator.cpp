@@ -1,6 +1,7 @@
 #include "semx/planner/gain_evaluator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -12,6 +13,70 @@ namespace semx::planner {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A voxel offset packed into one integer: three fields of kField bits, each biased by kBias, so
+// that the node's place plus a ray step's offset is one addition with no carry between fields
+// (every field stays in [0, 2^kField)). The fields' low kBlockBits are the voxel's index in its
+// block, the rest the block.
+constexpr int kField = 21;
+constexpr int64_t kBias = int64_t{1} << (kField - 1);
+constexpr uint64_t kFieldMask = (uint64_t{1} << kField) - 1;
+constexpr uint64_t kLocalBits = static_cast<uint64_t>(map::kBlockMask) |
+                                (static_cast<uint64_t>(map::kBlockMask) << kField) |
+                                (static_cast<uint64_t>(map::kBlockMask) << (2 * kField));
+constexpr uint64_t kBlockSelect = ((uint64_t{1} << (3 * kField)) - 1) & ~kLocalBits;
+
+uint64_t pack(int64_t x, int64_t y, int64_t z) {
+  return static_cast<uint64_t>(x + (y << kField) + (z << (2 * kField)));
+}
+// The voxel's index in its block (map::local_index's layout).
+size_t local_of(uint64_t u) {
+  return static_cast<size_t>((u & map::kBlockMask) |
+                             ((u >> (kField - map::kBlockBits)) & (map::kBlockMask << map::kBlockBits)) |
+                             ((u >> (2 * kField - 2 * map::kBlockBits)) & (map::kBlockMask << (2 * map::kBlockBits))));
+}
+int block_field(uint64_t u, int axis) {
+  return static_cast<int>(((u >> (axis * kField)) & kFieldMask) >> map::kBlockBits) -
+         static_cast<int>(kBias >> map::kBlockBits);
+}
+
+// Stands for every block the map has not allocated (all unknown), so a step never tests for null.
+const map::VoxelBlock& unknown_block() {
+  static const map::VoxelBlock block{};
+  return block;
+}
+
+// Whether a block's voxel has all six face neighbours in the block, by its index.
+const std::array<uint8_t, map::kBlockVolume>& inner_voxel() {
+  static const std::array<uint8_t, map::kBlockVolume> table = [] {
+    std::array<uint8_t, map::kBlockVolume> t{};
+    auto in = [](int v) { return v > 0 && v < map::kBlockMask; };
+    for (int i = 0; i < map::kBlockVolume; ++i) {
+      t[static_cast<size_t>(i)] = in(i & map::kBlockMask) && in((i >> map::kBlockBits) & map::kBlockMask) &&
+                                  in(i >> (2 * map::kBlockBits));
+    }
+    return t;
+  }();
+  return table;
+}
+
+// An unknown voxel's kind from its six face neighbours' states: the states' bits say free (1) and
+// occupied (2), so their OR says whether any neighbour is free and any occupied.
+static_assert(static_cast<int>(map::VoxelState::kFree) == 1 && static_cast<int>(map::VoxelState::kOccupied) == 2);
+GainVoxel kind_of(const map::VoxelState (&n)[6]) {
+  constexpr GainVoxel kinds[4] = {GainVoxel::kUnknown, GainVoxel::kFrontier, GainVoxel::kUnknown,
+                                  GainVoxel::kSurface};
+  const unsigned any = static_cast<unsigned>(n[0]) | static_cast<unsigned>(n[1]) | static_cast<unsigned>(n[2]) |
+                       static_cast<unsigned>(n[3]) | static_cast<unsigned>(n[4]) | static_cast<unsigned>(n[5]);
+  return kinds[any & 3];
+}
+
+// Squares of the points of [lo, hi].
+std::pair<double, double> square_range(double lo, double hi) {
+  const double a = lo * lo, b = hi * hi;
+  if (lo <= 0.0 && hi >= 0.0) return {0.0, std::max(a, b)};
+  return {std::min(a, b), std::max(a, b)};
+}
 }  // namespace
 
 using map::VoxelKey;
@@ -104,6 +169,39 @@ bool GainEvaluator::in_sector(const Eigen::Vector3d& c) const {
   // |z| <= tan(vfov/2) * horizontal distance, squared.
   const double h2 = c.x() * c.x() + c.y() * c.y();
   return c.z() * c.z() <= tan_half_vfov_ * tan_half_vfov_ * h2 * (1.0 + 1e-12);
+}
+
+uint8_t GainEvaluator::sector_of_cube(const Eigen::Vector3d& o, double h) const {
+  // in_sector() on every point of the cube, from the ranges of its squared terms. The margin eps
+  // (m², far above the rounding of c) leaves to the exact test every cube that comes near a
+  // boundary, so the table never decides a voxel differently from in_sector(c).
+  constexpr double eps = 1e-9;
+  const auto x = square_range(o.x() - h, o.x() + h), y = square_range(o.y() - h, o.y() + h),
+             z = square_range(o.z() - h, o.z() + h);
+  const double r2_lo = x.first + y.first + z.first, r2_hi = x.second + y.second + z.second;
+  const double h2_lo = x.first + y.first, h2_hi = x.second + y.second;
+  const double min2 = config_.min_range * config_.min_range, max2 = config_.max_range * config_.max_range;
+  const double t2 = tan_half_vfov_ * tan_half_vfov_;
+  if (r2_hi < min2 - eps || r2_lo > max2 + eps || z.first > t2 * h2_hi * (1.0 + 1e-12) + eps) return kOut;
+  if (r2_lo > min2 + eps && r2_hi < max2 - eps && z.second < t2 * h2_lo - eps) return kIn;
+  return kTest;
+}
+
+uint16_t GainEvaluator::bin_of_cube(const Eigen::Vector3d& o, double h) const {
+  const int bins = config_.yaw_bins;
+  if (bins == 1) return 0;
+  // Bin b is where the cross product with its start boundary is >= 0 and with the next one's < 0
+  // (bin_near()); both are linear, so the square's corners bound them.
+  constexpr double eps = 1e-9;
+  const int b = bin_of(std::atan2(o.y(), o.x()));
+  const Eigen::Vector2d& u0 = bin_boundary_[static_cast<size_t>(b)];
+  const Eigen::Vector2d& u1 = bin_boundary_[static_cast<size_t>(b + 1 == bins ? 0 : b + 1)];
+  for (const double cx : {o.x() - h, o.x() + h}) {
+    for (const double cy : {o.y() - h, o.y() + h}) {
+      if (!(u0.x() * cy - u0.y() * cx > eps) || !(u1.x() * cy - u1.y() * cx < -eps)) return kNoBin;
+    }
+  }
+  return static_cast<uint16_t>(b);
 }
 
 void GainEvaluator::add(NodeGain& g, int b, GainVoxel kind) const {
@@ -232,6 +330,23 @@ void GainEvaluator::prepare(double res) {
     hz_ = std::max(hz_, std::abs(static_cast<int>(r.dz)));
   }
   const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
+  const int nx = 2 * hx_ + 1;
+  // A node lies anywhere in its voxel: its offset to the voxel's centre is within half a voxel.
+  const double h = 0.5 * res + 1e-9;
+  step_packed_.clear();
+  step_info_.clear();
+  step_packed_.reserve(ray_steps_.size());
+  step_info_.reserve(ray_steps_.size());
+  for (const RayStep& r : ray_steps_) {
+    step_packed_.push_back(pack(r.dx, r.dy, r.dz));
+    const Eigen::Vector3d o(r.dx * res, r.dy * res, r.dz * res);
+    StepInfo info;
+    info.bit = static_cast<uint32_t>((r.dx + hx_) + nx * ((r.dy + hx_) + nx * (r.dz + hz_)));
+    info.sector = sector_of_cube(o, h);
+    info.bin = bin_of_cube(o, h);
+    info.pad = 0;
+    step_info_.push_back(info);
+  }
   seen_.assign((bits + 63) / 64, 0);
   surface_.assign(seen_.size(), 0);
   // Blocks an offset or one of its face neighbours can fall in, relative to the node's block,
@@ -272,7 +387,6 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
     if (config_.surface_occludes) std::memset(surface_.data(), 0, surface_.size() * sizeof(uint64_t));
   }
   const bool occlude = config_.surface_occludes;
-  const int nx = 2 * hx_ + 1;
   const VoxelKey origin_block = map::block_of(origin);
   const int ox = origin.x & map::kBlockMask, oy = origin.y & map::kBlockMask, oz = origin.z & map::kBlockMask;
   const map::VoxelBlock* origin_b = grid.find_block(origin_block);
@@ -317,88 +431,96 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
                              ly < map::kBlockMask ? own(li + dy1) : state_at(ux, uy + 1, uz),
                              lz > 0 ? own(li - dz1) : state_at(ux, uy, uz - 1),
                              lz < map::kBlockMask ? own(li + dz1) : state_at(ux, uy, uz + 1)};
-    bool free = false, occupied = false;
-    for (const VoxelState v : n) {
-      free |= v == VoxelState::kFree;
-      occupied |= v == VoxelState::kOccupied;
-    }
-    return free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
+    return kind_of(n);
   };
   int64_t steps = 0;
+  const map::VoxelBlock* const none = &unknown_block();
+  const uint8_t* const inner = inner_voxel().data();
+  const uint64_t base = pack(kBias + ox, kBias + oy, kBias + oz);
+  const uint64_t* const packed = step_packed_.data();
+  const StepInfo* const info = step_info_.data();
+  // The gain's ray casting, the planner's hottest loop: a step through a free voxel is one
+  // addition, a mask and compare for the block, the index in the block and one load.
   for (size_t ray = 0; ray < directions_.size(); ++ray) {
     const int ray_bin = direction_bin_[ray];
-    // The ray's voxels as offsets from the node's voxel (prepare()); the block is looked up only
-    // when the offset leaves the one looked up last.
-    int cur_bx = 0, cur_by = 0, cur_bz = 0;
-    const map::VoxelBlock* b = origin_b;
+    // The block is looked up only when the step leaves the one looked up last.
+    uint64_t cur = base & kBlockSelect;
+    const map::VoxelBlock* b = origin_b ? origin_b : none;
     const VoxelSet::Mask* ignored_mask = origin_ignored;
-    const RayStep* it = &ray_steps_[ray_begin_[ray]];
-    const RayStep* const end = &ray_steps_[ray_begin_[ray + 1]];
-    for (; it != end; ++it) {
-      ++steps;
-      const int ux = ox + it->dx, uy = oy + it->dy, uz = oz + it->dz;
-      const int bx = ux >> map::kBlockBits, by = uy >> map::kBlockBits, bz = uz >> map::kBlockBits;
-      if (bx != cur_bx || by != cur_by || bz != cur_bz) {
-        cur_bx = bx;
-        cur_by = by;
-        cur_bz = bz;
+    const size_t first_step = ray_begin_[ray], last_step = ray_begin_[ray + 1];
+    steps += static_cast<int64_t>(last_step - first_step);
+    for (size_t i = first_step; i != last_step; ++i) {
+      const uint64_t u = base + packed[i];
+      if ((u & kBlockSelect) != cur) {
+        cur = u & kBlockSelect;
         // Rays cross ~4 blocks each and share them: each block is looked up once per evaluation.
-        const size_t slot = slot_of(bx, by, bz);
-        b = block_ptr_[slot];
+        const size_t slot = slot_of(block_field(u, 0), block_field(u, 1), block_field(u, 2));
+        b = block_ptr_[slot] ? block_ptr_[slot] : none;
         ignored_mask = ignored_ptr_[slot];
       }
-      const int lx = ux & map::kBlockMask, ly = uy & map::kBlockMask, lz = uz & map::kBlockMask;
-      const size_t li = static_cast<size_t>(lx | (ly << map::kBlockBits) | (lz << (2 * map::kBlockBits)));
-      const VoxelState s = b ? b->state[li] : VoxelState::kUnknown;
-      if (s == VoxelState::kOccupied) break;
+      const size_t li = local_of(u);
+      const VoxelState s = b->state[li];
+      if (s == VoxelState::kOccupied) {
+        steps -= static_cast<int64_t>(last_step - i - 1);
+        break;
+      }
       if (s != VoxelState::kUnknown) continue;
-      const size_t bit =
-          static_cast<size_t>(it->dx + hx_) +
-          static_cast<size_t>(nx) * (static_cast<size_t>(it->dy + hx_) +
-                                     static_cast<size_t>(nx) * static_cast<size_t>(it->dz + hz_));
-      uint64_t& word = seen_[bit >> 6];
-      const uint64_t mask = uint64_t{1} << (bit & 63);
+      const StepInfo& in = info[i];
+      uint64_t& word = seen_[in.bit >> 6];
+      const uint64_t mask = uint64_t{1} << (in.bit & 63);
       if (word & mask) {
-        if (occlude && (surface_[bit >> 6] & mask)) break;
+        if (occlude && (surface_[in.bit >> 6] & mask)) {
+          steps -= static_cast<int64_t>(last_step - i - 1);
+          break;
+        }
         continue;
       }
       word |= mask;
-      const VoxelKey k{origin.x + it->dx, origin.y + it->dy, origin.z + it->dz};
-      const Eigen::Vector3d c = km.center(k) - p;
+      const RayStep& d = ray_steps_[i];
+      // Only a voxel on its block's faces needs its place (its neighbours in other blocks).
+      auto border = [&]() { return border_kind(ox + d.dx, oy + d.dy, oz + d.dz, b, li); };
       GainVoxel kind = GainVoxel::kUnknown;
       bool known_kind = false;
-      if (lx > 0 && ly > 0 && lz > 0 && lx < map::kBlockMask && ly < map::kBlockMask &&
-          lz < map::kBlockMask) {
+      if (inner[li]) {
         // All six neighbours are in this block: read them directly (an unallocated block is all
         // unknown, so its inner voxels are "normal").
         known_kind = true;
-        if (b) {
-          constexpr size_t dy1 = map::kBlockSize, dz1 = map::kBlockSize * map::kBlockSize;
-          const VoxelState n[6] = {b->state[li - 1],   b->state[li + 1],   b->state[li - dy1],
-                                   b->state[li + dy1], b->state[li - dz1], b->state[li + dz1]};
-          bool free = false, occupied = false;
-          for (const VoxelState v : n) {
-            free |= v == VoxelState::kFree;
-            occupied |= v == VoxelState::kOccupied;
-          }
-          kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
-        }
+        constexpr size_t dy1 = map::kBlockSize, dz1 = map::kBlockSize * map::kBlockSize;
+        const VoxelState n[6] = {b->state[li - 1],   b->state[li + 1],   b->state[li - dy1],
+                                 b->state[li + dy1], b->state[li - dz1], b->state[li + dz1]};
+        kind = kind_of(n);
       }
       if (occlude) {
         // The kind decides whether the ray goes on, inside the sector or not.
         if (!known_kind) {
-          kind = border_kind(ux, uy, uz, b, li);
+          kind = border();
           known_kind = true;
         }
-        if (kind == GainVoxel::kSurface) surface_[bit >> 6] |= mask;
+        if (kind == GainVoxel::kSurface) surface_[in.bit >> 6] |= mask;
       }
-      if (in_sector(c) && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li)))) {
-        if (!known_kind) kind = border_kind(ux, uy, uz, b, li);
-        const int bin = bin_near(c, ray_bin);
+      // The sector test and the bin from the step's table where they hold wherever the node is
+      // in its voxel, else from the voxel's centre as seen from the node.
+      auto key = [&]() { return VoxelKey{origin.x + d.dx, origin.y + d.dy, origin.z + d.dz}; };
+      Eigen::Vector3d c;
+      bool have_c = false;
+      auto centre = [&]() -> const Eigen::Vector3d& {
+        if (!have_c) {
+          c = km.center(key()) - p;
+          have_c = true;
+        }
+        return c;
+      };
+      const bool inside = in.sector == kIn || (in.sector == kTest && in_sector(centre()));
+      if (inside && !(ignored_mask && VoxelSet::test(*ignored_mask, static_cast<int>(li)))) {
+        if (!known_kind) kind = border();
+        const int bin = in.bin != kNoBin ? in.bin : bin_near(centre(), ray_bin);
         add(g, bin, kind);
-        if (counted && in_window(bin)) counted->push_back(k);
+        if (counted && in_window(bin)) counted->push_back(key());
       }
-      if (occlude && kind == GainVoxel::kSurface) break;
+      if (occlude && kind == GainVoxel::kSurface) {
+        steps -= static_cast<int64_t>(last_step - i - 1);
+        break;
+      }
     }
   }
   if (stats) {

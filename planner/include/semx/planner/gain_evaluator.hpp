@@ -114,12 +114,30 @@ class GainEvaluator {
   std::vector<int> direction_bin_;             // bin of each direction's azimuth
   std::vector<Eigen::Vector2d> bin_boundary_;  // unit vector at the start of each bin
   // Each ray's voxels from the centre of the node's voxel, as offsets; ray r's at
-  // [ray_begin_[r], ray_begin_[r+1]).
+  // [ray_begin_[r], ray_begin_[r+1]). Three arrays, so that the steps through free voxels (most
+  // of them) read only the first: the offset packed as three biased fields (kField bits each),
+  // added to the node's packed place in its block in one integer addition.
   struct RayStep {
     int16_t dx, dy, dz, pad;
   };
+  // What an unknown voxel's step needs: its bit in seen_, and the sector test and azimuth bin
+  // where they are the same wherever the node lies in its voxel (else computed, kTest / kNoBin).
+  struct StepInfo {
+    uint32_t bit;
+    uint16_t bin;
+    uint8_t sector;
+    uint8_t pad;
+  };
+  enum : uint8_t { kOut = 0, kIn = 1, kTest = 2 };
+  static constexpr uint16_t kNoBin = 0xFFFF;
+  std::vector<uint64_t> step_packed_;
+  std::vector<StepInfo> step_info_;
   std::vector<RayStep> ray_steps_;
   std::vector<uint32_t> ray_begin_;
+  // Sector and bin of every point of the cube [o - h, o + h] (o a voxel's offset, h half a voxel
+  // and a margin for rounding), or kTest / kNoBin when the cube straddles a boundary.
+  uint8_t sector_of_cube(const Eigen::Vector3d& o, double h) const;
+  uint16_t bin_of_cube(const Eigen::Vector3d& o, double h) const;
   // The blocks around the node's, looked up in this evaluation (block_stamp_ == stamp_).
   std::vector<const map::VoxelBlock*> block_ptr_;
   std::vector<const VoxelSet::Mask*> ignored_ptr_;  // the ignored voxels of the same blocks
