@@ -282,54 +282,58 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
       });
   // gx[z][y][i]: squared x distance from the chunk's column i to the nearest obstacle of row (y, z).
   // Rows and planes with nothing below the cap are skipped by the later passes.
-  std::vector<int32_t>& gx = fill_scratch_.gx;
+  std::vector<int16_t>& gx = fill_scratch_.gx;
+  const int16_t cap16 = static_cast<int16_t>(cap2);
   std::vector<uint8_t>& row_near = fill_scratch_.row_near;
-  gx.assign(static_cast<size_t>(n) * n * kChunkSize, cap2);
+  gx.assign(static_cast<size_t>(n) * n * kChunkSize, cap16);
   row_near.assign(static_cast<size_t>(n) * n, 0);
   for (size_t r = 0; r < rows.size(); ++r) {
     const uint64_t m = rows[r];
     if (m == 0) continue;
     row_near[r] = 1;
-    int32_t* g = &gx[r * kChunkSize];
+    int16_t* g = &gx[r * kChunkSize];
     for (int i = 0; i < kChunkSize; ++i) {
       const int c = reach + i;  // < n <= 64
       const uint64_t low = m & (c >= 63 ? ~uint64_t{0} : (uint64_t{2} << c) - 1), high = m >> c;
       const int left = low ? c - (63 - __builtin_clzll(low)) : 2 * n;
       const int right = high ? __builtin_ctzll(high) : 2 * n;
       const int32_t d = std::min(left, right);
-      g[i] = std::min(cap2, d * d);
+      g[i] = static_cast<int16_t>(std::min(cap2, d * d));
     }
   }
   // gy[z][j][i]: min over y of gx + (y - y_j)^2.
-  std::vector<int32_t>& gy = fill_scratch_.gy;
+  std::vector<int16_t>& gy = fill_scratch_.gy;
   std::vector<uint8_t>& plane_near = fill_scratch_.plane_near;
-  gy.assign(static_cast<size_t>(n) * kChunkSize * kChunkSize, cap2);
+  gy.assign(static_cast<size_t>(n) * kChunkSize * kChunkSize, cap16);
   plane_near.assign(static_cast<size_t>(n), 0);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y) {
       if (!row_near[static_cast<size_t>(z) * n + y]) continue;
       plane_near[static_cast<size_t>(z)] = 1;
-      const int32_t* __restrict g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
+      const int16_t* __restrict g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
       for (int j = 0; j < kChunkSize; ++j) {
         const int32_t dy = y - (reach + j), q = dy * dy;
         if (q >= cap2) continue;
+        const int16_t q16 = static_cast<int16_t>(q);
         // Restrict: the compiler vectorises the row only when it knows gx and gy apart.
-        int32_t* __restrict out_row = &gy[(static_cast<size_t>(z) * kChunkSize + j) * kChunkSize];
-        for (int i = 0; i < kChunkSize; ++i) out_row[i] = std::min(out_row[i], g[i] + q);
+        int16_t* __restrict out_row = &gy[(static_cast<size_t>(z) * kChunkSize + j) * kChunkSize];
+        for (int i = 0; i < kChunkSize; ++i)
+          out_row[i] = std::min(out_row[i], static_cast<int16_t>(g[i] + q16));
       }
     }
   // Along z, straight into the chunk's values.
   const double res = grid_->resolution();
-  std::array<int32_t, kChunkVolume> best;
-  best.fill(cap2);
+  std::array<int16_t, kChunkVolume> best;
+  best.fill(cap16);
   for (int z = 0; z < n; ++z) {
     if (!plane_near[static_cast<size_t>(z)]) continue;
-    const int32_t* __restrict g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
+    const int16_t* __restrict g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
     for (int k = 0; k < kChunkSize; ++k) {
       const int32_t dz = z - (reach + k), q = dz * dz;
       if (q >= cap2) continue;
-      int32_t* __restrict b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
-      for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], g[i] + q);
+      const int16_t q16 = static_cast<int16_t>(q);
+      int16_t* __restrict b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
+      for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], static_cast<int16_t>(g[i] + q16));
     }
   }
   for (int i = 0; i < kChunkVolume; ++i)
