@@ -333,7 +333,8 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
       if (q >= cap2) continue;
       const int16_t q16 = static_cast<int16_t>(q);
       int16_t* __restrict b = &best[static_cast<size_t>(k) * kChunkSize * kChunkSize];
-      for (int i = 0; i < kChunkSize * kChunkSize; ++i) b[i] = std::min(b[i], static_cast<int16_t>(g[i] + q16));
+      for (int i = 0; i < kChunkSize * kChunkSize; ++i)
+        b[i] = std::min(b[i], static_cast<int16_t>(g[i] + q16));
     }
   }
   for (int i = 0; i < kChunkVolume; ++i)

@@ -31,9 +31,9 @@ uint64_t pack(int64_t x, int64_t y, int64_t z) {
 }
 // The voxel's index in its block (map::local_index's layout).
 size_t local_of(uint64_t u) {
-  return static_cast<size_t>((u & map::kBlockMask) |
-                             ((u >> (kField - map::kBlockBits)) & (map::kBlockMask << map::kBlockBits)) |
-                             ((u >> (2 * kField - 2 * map::kBlockBits)) & (map::kBlockMask << (2 * map::kBlockBits))));
+  return static_cast<size_t>(
+      (u & map::kBlockMask) | ((u >> (kField - map::kBlockBits)) & (map::kBlockMask << map::kBlockBits)) |
+      ((u >> (2 * kField - 2 * map::kBlockBits)) & (map::kBlockMask << (2 * map::kBlockBits))));
 }
 int block_field(uint64_t u, int axis) {
   return static_cast<int>(((u >> (axis * kField)) & kFieldMask) >> map::kBlockBits) -
@@ -62,12 +62,14 @@ const std::array<uint8_t, map::kBlockVolume>& inner_voxel() {
 
 // An unknown voxel's kind from its six face neighbours' states: the states' bits say free (1) and
 // occupied (2), so their OR says whether any neighbour is free and any occupied.
-static_assert(static_cast<int>(map::VoxelState::kFree) == 1 && static_cast<int>(map::VoxelState::kOccupied) == 2);
+static_assert(static_cast<int>(map::VoxelState::kFree) == 1 &&
+              static_cast<int>(map::VoxelState::kOccupied) == 2);
 GainVoxel kind_of(const map::VoxelState (&n)[6]) {
   constexpr GainVoxel kinds[4] = {GainVoxel::kUnknown, GainVoxel::kFrontier, GainVoxel::kUnknown,
                                   GainVoxel::kSurface};
-  const unsigned any = static_cast<unsigned>(n[0]) | static_cast<unsigned>(n[1]) | static_cast<unsigned>(n[2]) |
-                       static_cast<unsigned>(n[3]) | static_cast<unsigned>(n[4]) | static_cast<unsigned>(n[5]);
+  const unsigned any = static_cast<unsigned>(n[0]) | static_cast<unsigned>(n[1]) |
+                       static_cast<unsigned>(n[2]) | static_cast<unsigned>(n[3]) |
+                       static_cast<unsigned>(n[4]) | static_cast<unsigned>(n[5]);
   return kinds[any & 3];
 }
 

@@ -17,7 +17,8 @@
 // Rays: rays_azimuth × rays_elevation directions, evenly spread around the node and across the
 // vertical field of view, each walked voxel by voxel (3-D DDA) to max_range from the centre of the
 // node's voxel (so the walks are computed once; the sector test and a voxel's azimuth bin use the
-// node's own position); each voxel counts at most once per node. Rays sample the view: with the
+// node's own position, read from per-step tables where every position in the voxel gives the same
+// answer); each voxel counts at most once per node. Rays sample the view: with the
 // defaults (128 × 10) every voxel within about 2 m is reached, farther ones in part, so U counts
 // the distinct voxels the rays reach.
 // evaluate_exact() counts every visible voxel of the sector by enumeration (the reference of the
