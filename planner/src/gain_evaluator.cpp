@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 
 #include "semx/core/angles.hpp"
 #include "semx/map/raycast.hpp"
@@ -331,6 +332,9 @@ void GainEvaluator::prepare(double res) {
     hx_ = std::max({hx_, std::abs(static_cast<int>(r.dx)), std::abs(static_cast<int>(r.dy))});
     hz_ = std::max(hz_, std::abs(static_cast<int>(r.dz)));
   }
+  // The packed fields hold the node's place in its block plus any offset without a carry.
+  if (hx_ + map::kBlockSize >= kBias || hz_ + map::kBlockSize >= kBias)
+    throw std::invalid_argument("gain: max_range / resolution too large for the ray tables");
   const size_t bits = static_cast<size_t>(2 * hx_ + 1) * (2 * hx_ + 1) * (2 * hz_ + 1);
   const int nx = 2 * hx_ + 1;
   // A node lies anywhere in its voxel: its offset to the voxel's centre is within half a voxel.

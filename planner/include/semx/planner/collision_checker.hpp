@@ -137,8 +137,9 @@ class CollisionChecker {
   struct FillScratch {
     std::vector<uint64_t> rows;  // obstacle bits per row of the region
     std::vector<uint8_t> row_near, plane_near;
-    // Squared distances in voxels, below 2 reach^2 <= 2 * 28^2 (rows of at most 64 voxels): 16
-    // bits, so that SSE2's 16-bit minimum takes eight at once (it has none for 32 bits).
+    // Squared distances in voxels, below 3 reach^2 <= 3 * 28^2 (rows of at most 64 voxels; each
+    // pass adds one axis's square below reach^2): 16 bits, so that SSE2's 16-bit minimum takes
+    // eight at once (it has none for 32 bits).
     std::vector<int16_t> gx, gy;
   };
   mutable FillScratch fill_scratch_;
