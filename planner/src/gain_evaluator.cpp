@@ -156,13 +156,9 @@ int GainEvaluator::bin_of(double azimuth) const {
 
 bool GainEvaluator::classify(map::StateGrid::Reader& r, const VoxelKey& k, GainVoxel& kind) {
   if (r.state(k) != VoxelState::kUnknown) return false;
-  bool free = false, occupied = false;
-  for (const VoxelKey& d : map::kFaceNeighbours) {
-    const VoxelState s = r.state(k + d);
-    free |= s == VoxelState::kFree;
-    occupied |= s == VoxelState::kOccupied;
-  }
-  kind = free ? (occupied ? GainVoxel::kSurface : GainVoxel::kFrontier) : GainVoxel::kUnknown;
+  VoxelState n[6];
+  for (size_t i = 0; i < 6; ++i) n[i] = r.state(k + map::kFaceNeighbours[i]);
+  kind = kind_of(n);
   return true;
 }
 
@@ -454,8 +450,8 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
     const map::VoxelBlock* b = origin_b ? origin_b : none;
     const VoxelSet::Mask* ignored_mask = origin_ignored;
     const size_t first_step = ray_begin_[ray], last_step = ray_begin_[ray + 1];
-    steps += static_cast<int64_t>(last_step - first_step);
-    for (size_t i = first_step; i != last_step; ++i) {
+    size_t i = first_step;
+    for (; i != last_step; ++i) {
       const uint64_t u = base + packed[i];
       if ((u & kBlockSelect) != cur) {
         cur = u & kBlockSelect;
@@ -466,19 +462,13 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
       }
       const size_t li = local_of(u);
       const VoxelState s = b->state[li];
-      if (s == VoxelState::kOccupied) {
-        steps -= static_cast<int64_t>(last_step - i - 1);
-        break;
-      }
+      if (s == VoxelState::kOccupied) break;
       if (s != VoxelState::kUnknown) continue;
       const StepInfo& in = info[i];
       uint64_t& word = seen_[in.bit >> 6];
       const uint64_t mask = uint64_t{1} << (in.bit & 63);
       if (word & mask) {
-        if (occlude && (surface_[in.bit >> 6] & mask)) {
-          steps -= static_cast<int64_t>(last_step - i - 1);
-          break;
-        }
+        if (occlude && (surface_[in.bit >> 6] & mask)) break;
         continue;
       }
       word |= mask;
@@ -523,11 +513,10 @@ NodeGain GainEvaluator::evaluate(const map::StateGrid& grid, const Eigen::Vector
         add(g, bin, kind);
         if (counted && in_window(bin)) counted->push_back(key());
       }
-      if (occlude && kind == GainVoxel::kSurface) {
-        steps -= static_cast<int64_t>(last_step - i - 1);
-        break;
-      }
+      if (occlude && kind == GainVoxel::kSurface) break;
     }
+    // A ray that stopped at step i visited it too.
+    steps += static_cast<int64_t>(std::min(i + 1, last_step) - first_step);
   }
   if (stats) {
     ++stats->evaluations;
