@@ -1,5 +1,6 @@
 #include "semx/planner/aep_strategy.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -100,14 +101,18 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
 
   const SamplingConfig& s = config_.sampling;
   const AepConfig& a = config_.aep;
-  const int attempts = s.samples * s.max_attempts_factor;
+  const int init_nodes = a.init_nodes > 0 ? a.init_nodes : s.samples;
+  const int max_nodes = std::max(init_nodes, a.max_nodes);
+  const int attempts = max_nodes * s.max_attempts_factor;
   int kept = 0;
+  bool informative = false;  // a tree node's gain reached g_zero: stop at init_nodes
+  auto more = [&] { return kept < init_nodes || (kept < max_nodes && !informative); };
   auto edge_ok = [&](int from, const Eigen::Vector3d& p) {
     ++ctx.counters->edges_checked;
     const Eigen::Vector3d& q = tree_[static_cast<size_t>(from)].position;
     return from == 0 ? checker_.root_edge_free(q, p) : checker_.edge_free(q, p);
   };
-  for (int i = 0; i < attempts && kept < s.samples; ++i) {
+  for (int i = 0; i < attempts && more(); ++i) {
     ++ctx.counters->samples_drawn;
     core::Stopwatch sw;
     const Eigen::Vector3d c = ctx.pose.position;
@@ -177,6 +182,8 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     }
     ctx.counters->connect_ms += cw.ms();
     gain_of(ctx, tree_.back());
+    const double g = tree_.back().gain.gain;
+    informative = informative || (g >= a.g_zero && g >= config_.gain.min_gain);
     ++kept;
     ++ctx.counters->nodes_added;
     ++ctx.counters->edges_added;

@@ -173,6 +173,10 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   a.get("radius", c.aep.radius, 0.1, 100.0);
   a.get("cache_radius", c.aep.cache_radius, 0.0, 100.0);
   a.get("g_zero", c.aep.g_zero, 0.0, 1e12);
+  a.get("init_nodes", c.aep.init_nodes, 0, 100000);
+  a.get("max_nodes", c.aep.max_nodes, 0, 100000);
+  if (c.aep.max_nodes > 0 && c.aep.max_nodes < (c.aep.init_nodes > 0 ? c.aep.init_nodes : c.sampling.samples))
+    a.fail("max_nodes", "must not be below init_nodes (sampling.samples when init_nodes is 0)");
 
   auto f = m.child("fuel");
   FuelConfig& fu = c.fuel;

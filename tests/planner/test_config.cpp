@@ -85,6 +85,8 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(aep.radius);
   SAME(aep.cache_radius);
   SAME(aep.g_zero);
+  SAME(aep.init_nodes);
+  SAME(aep.max_nodes);
   SAME(fuel.min_cluster_voxels);
   SAME(fuel.major_cluster_voxels);
   SAME(fuel.major_coverage);
@@ -169,6 +171,9 @@ TEST(PlannerConfig, OverridesAndErrors) {
                ConfigError);                                                          // not a multiple of 32
   EXPECT_THROW(load_config<PlannerConfig>("", {"gain.max_range=0.2"}), ConfigError);  // below min_range
   EXPECT_THROW(load_config<PlannerConfig>("", {"collision.vehicle_size=[1, 2]"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"aep.init_nodes=20", "aep.max_nodes=10"}), ConfigError);
+  EXPECT_THROW(load_config<PlannerConfig>("", {"aep.max_nodes=30"}), ConfigError);  // below samples (45)
+  EXPECT_NO_THROW(load_config<PlannerConfig>("", {"aep.init_nodes=15", "aep.max_nodes=30"}));
   EXPECT_THROW(parse_planner_kind("DEP"), std::invalid_argument);
   EXPECT_THROW(load_config<PlannerConfig>("", {"fuel.view_radius_max=1.0"}), ConfigError);  // below min
   EXPECT_EQ(load_config<PlannerConfig>("", {"planner=fuel"}).kind(), PlannerKind::kFuel);

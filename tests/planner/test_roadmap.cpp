@@ -10,6 +10,7 @@
 
 #include "planner_test_util.hpp"
 #include "semx/core/angles.hpp"
+#include "semx/planner/aep_strategy.hpp"
 #include "semx/planner/collision_checker.hpp"
 #include "semx/planner/dep_strategy.hpp"
 #include "semx/planner/roadmap.hpp"
@@ -918,6 +919,26 @@ TEST(DepRoadmap, APocketTooFarOffTheWayDoesNotChangeTheGoal) {
   ASSERT_TRUE(near.valid && near_rule.valid);
   EXPECT_EQ(stops, 0);
   EXPECT_LT((near_rule.position - near.position).norm(), 1e-9);
+}
+
+// AEP grows its tree as aeplanner does: init_nodes nodes when one of them is informative, more up
+// to max_nodes while none is.
+TEST(AepTree, GrowsInitNodesWhenOneIsInformativeAndMaxNodesWhenNone) {
+  for (const bool all_known : {false, true}) {
+    PlanScene f("aep", 3);
+    f.config.aep.init_nodes = 6;
+    f.config.aep.max_nodes = 14;
+    const SyntheticWorld w = SyntheticWorld::room({10, 4, 2.5}, {1, 2, 1.2});
+    // The corridor's first 6 m (its frontier 1 m ahead of the vehicle), or all of it.
+    w.reveal(f.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(all_known ? 10.2 : 6.0, 4.2, 2.7)});
+    f.frontiers.reset(f.grid);
+    AepStrategy aep(f.config);
+    aep.on_map_reset();
+    PlanContext ctx = f.context({5.0, 2.0, 1.2});
+    const PlanOutcome out = aep.plan(ctx);
+    EXPECT_EQ(aep.tree_size(), all_known ? 15u : 7u) << (all_known ? "nothing to see" : "the frontier ahead");
+    EXPECT_EQ(out.goal.valid, !all_known) << out.reason;
+  }
 }
 
 }  // namespace

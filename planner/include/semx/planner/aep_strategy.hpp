@@ -2,7 +2,9 @@
 // the same map, sensor model, gain and collision checks as DEP.
 //
 // Local planning: each cycle an RRT* is grown from the vehicle (aep.step, choose-parent and
-// rewiring within aep.rewire_radius, up to `samples` nodes in a box of half width aep.radius).
+// rewiring within aep.rewire_radius, in a box of half width aep.radius): aep.init_nodes nodes
+// (sampling.samples by default), then more while none has a gain of aep.g_zero, up to
+// aep.max_nodes (AEP's initial and cutoff iterations).
 // Gains come from a persistent cache: a tree node within aep.cache_radius of a cached position
 // whose gain is not stale (no map change within sensor range since) reuses it; otherwise it is
 // evaluated and cached. A node's value is G(n)·exp(-λ·c(n)); when the best local value's gain
@@ -41,6 +43,7 @@ class AepStrategy : public Strategy {
 
   bool last_was_fallback() const { return fallback_; }
   size_t cache_size() const { return cache_.num_nodes(); }
+  size_t tree_size() const { return tree_.size(); }  // with the root
 
  private:
   void gain_of(PlanContext& ctx, TreeNode& n);

@@ -321,6 +321,14 @@ struct AepConfig {
   // Local gain below this triggers the frontier fallback. Below gain.min_gain it has no effect (a
   // local goal needs min_gain anyway), so it defaults to the same 1000.
   double g_zero = 1000.0;
+  // Tree nodes grown per cycle: at least init_nodes, then more while no node's gain reaches
+  // g_zero, up to max_nodes; 0 is sampling.samples (init_nodes) and init_nodes (max_nodes).
+  // AEP's own code grows 15 and at most 30 (aeplanner's expandRRT, initial_iterations and
+  // cutoff_iterations); the defaults grow DEP's sampling density, as in the paper's comparison:
+  // with 15/30 the cycle took half the time in a 600 m² world, but Time_r came 20 s later over
+  // 33 runs (docs/planner.md, "AEP's own tree size").
+  int init_nodes = 0;
+  int max_nodes = 0;
 };
 
 // FUEL (Zhou et al., RA-L 2021; fuel_strategy.hpp). The defaults are FUEL's own
