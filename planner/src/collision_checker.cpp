@@ -328,7 +328,7 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
     for (int y = 0; y < n; ++y) {
       if (!row_near[static_cast<size_t>(z) * n + y]) continue;
       plane_near[static_cast<size_t>(z)] = 1;
-      const int16_t* __restrict g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
+      const int16_t* g = &gx[(static_cast<size_t>(z) * n + y) * kChunkSize];
       for (int j = 0; j < kChunkSize; ++j) {
         const int32_t dy = y - (reach + j), q = dy * dy;
         if (q >= cap2) continue;
@@ -341,7 +341,7 @@ void CollisionChecker::fill_chunk(const VoxelKey& chunk, bool unknown_is_obstacl
   best.fill(cap16);
   for (int z = 0; z < n; ++z) {
     if (!plane_near[static_cast<size_t>(z)]) continue;
-    const int16_t* __restrict g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
+    const int16_t* g = &gy[static_cast<size_t>(z) * kChunkSize * kChunkSize];
     for (int k = 0; k < kChunkSize; ++k) {
       const int32_t dz = z - (reach + k), q = dz * dz;
       if (q >= cap2) continue;
