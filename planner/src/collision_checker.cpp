@@ -518,6 +518,11 @@ bool CollisionChecker::samples_free(const Eigen::Vector3d& a, const Eigen::Vecto
   // whose value exceeds passage_clearance by |u|_1 * h / 2 vouches for the h / 2 on either side:
   // every point of the edge, not only the samples, keeps what the controller checks.
   const double slope = ((b - a) / length).lpNorm<1>();
+  // The bare box swept over a stretch of half length `half` lies in the box grown by this times
+  // `half`: a doorway point vouches for its stretch with it, as the ESDF's slope does. The box at
+  // the point alone let its corner, 0.354 m from the centre, touch a wall's end between two fine
+  // points that both kept door_clearance (0.34 m): a collision in the closed loop.
+  const Eigen::Vector3d sweep = ((b - a) / length).cwiseAbs();
   const int n = std::max(1, static_cast<int>(std::ceil(length / config_.edge_step)));
   const double h = length / n;
   const int fine = std::max(1, static_cast<int>(std::ceil(h / kFineStep)));
@@ -546,7 +551,7 @@ bool CollisionChecker::samples_free(const Eigen::Vector3d& a, const Eigen::Vecto
     // kDoorUnknownClearance counting unknown ones too. Jambs seen at grazing angles leave unknown
     // voxels that closed doorways the vehicle had flown through (env3 stayed at 84 % with them
     // counted in full); centre_line_free and door_length keep edges out of unknown space.
-    if (!region_free(p, vehicle_half_, 0.0, true)) return 0;
+    if (!region_free(p, vehicle_half_ + half * sweep, 0.0, true)) return 0;
     const double need = config_.door_clearance + slope * half;
     if (esdf(p, need, false) < need) return 0;
     return esdf(p, kDoorUnknownClearance + slope * half) >= kDoorUnknownClearance + slope * half ? 1 : 0;

@@ -292,6 +292,24 @@ TEST(Collision, EdgesKeepTheClearanceAllAlong) {
       EXPECT_GE(std::hypot(dx, dy), 0.35 - 1e-9) << off << " " << t;
     }
   }
+  // The bare body box (0.25 m half sizes) past the pillar's corner: an ESDF of 0.35 m leaves its
+  // corner 0.354 m from the centre free to touch the cube between two fine points. AEP's edge
+  // past a wall's end did so for 8 mm (gen-s6, aep 15/30, seed 1: one collision step at 441.7 s).
+  int passed = 0;
+  for (double dx = -0.3; dx < 0.1; dx += 0.003) {
+    for (double deg = 30.0; deg <= 80.0; deg += 5.0) {
+      const double th = deg * core::kPi / 180.0;
+      const Eigen::Vector3d a(2.9 + dx, 2.7, 1.2), b = a + 1.5 * Eigen::Vector3d(-std::cos(th), -std::sin(th), 0.0);
+      if (!c.edge_free(a, b)) continue;
+      ++passed;
+      for (double t = 0; t <= 1.0; t += 0.0002) {
+        const Eigen::Vector3d p = a + t * (b - a);
+        const bool overlaps = p.x() + 0.25 > 2.9 && p.x() - 0.25 < 3.1 && p.y() + 0.25 > 1.9 && p.y() - 0.25 < 2.1;
+        ASSERT_FALSE(overlaps) << "dx " << dx << " at " << deg << " deg: " << p.transpose();
+      }
+    }
+  }
+  EXPECT_GT(passed, 100);
   // Into unknown space: blocked.
   map::StateGrid h = known_room();
   fill_m(h, {4, 0, 0}, {6, 4, 2.5}, VoxelState::kUnknown);
