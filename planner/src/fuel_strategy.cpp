@@ -379,12 +379,41 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       add_tour_costs(ctx, search_, reps, means, problem);
     }
     core::Stopwatch tw;
-    const Tour tour = solve_open_tour(problem, f.exact_tour_max);
+    // With latency_tour, a tour's cost is its weighted latency (each site weighs what its
+    // representative viewpoint covers), found from the shortest tour by local moves; the order
+    // that keeps the target keeps it first and orders the rest so.
+    std::vector<double> weight(static_cast<size_t>(n), 0.0);
+    for (int i = 0; i < n - 1; ++i) weight[static_cast<size_t>(i + 1)] = rep_view(i).coverage;
+    auto by_latency = [&](Tour t, bool keep_first) {
+      if (t.order.size() < 2) {
+        t.cost = latency_cost(problem, t.order, weight);
+        return t;
+      }
+      const int head = t.order.front();
+      std::vector<int> rest = t.order;
+      if (keep_first) rest.erase(rest.begin());
+      auto whole = [&](const std::vector<int>& r) {
+        if (!keep_first) return r;
+        std::vector<int> o{head};
+        o.insert(o.end(), r.begin(), r.end());
+        return o;
+      };
+      const auto objective = [&](const std::vector<int>& r) {
+        return latency_cost(problem, whole(r), weight);
+      };
+      rest = improve_order(rest, objective, f.latency_evaluations, false);
+      t.order = whole(rest);
+      t.cost = latency_cost(problem, t.order, weight);
+      return t;
+    };
+    Tour tour = solve_open_tour(problem, f.exact_tour_max);
+    if (f.latency_tour) tour = by_latency(std::move(tour), false);
     if (keep_cost) {
       *keep_cost = kInf;
       for (int i = 0; i < n - 1; ++i) {
-        if (sites_[static_cast<size_t>(i)].cluster == keep)
-          *keep_cost = solve_open_tour(problem, f.exact_tour_max, i + 1).cost;
+        if (sites_[static_cast<size_t>(i)].cluster != keep) continue;
+        Tour k = solve_open_tour(problem, f.exact_tour_max, i + 1);
+        *keep_cost = f.latency_tour ? by_latency(std::move(k), true).cost : k.cost;
       }
     }
     for (int v : tour.order) tour_.push_back(sites_[static_cast<size_t>(v - 1)].cluster);

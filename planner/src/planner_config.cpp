@@ -203,6 +203,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("covered_fraction", fu.covered_fraction, 0.0, 1.0);
   f.get("replan_period", fu.replan_period, 0.0, 3600.0);
   f.get("switch_margin", fu.switch_margin, 0.0, 1.0);
+  f.get("latency_tour", fu.latency_tour);
+  f.get("latency_evaluations", fu.latency_evaluations, 1, 1000000);
   f.get("search_step", fu.search_step, 1, 8);
   f.get("low_clearance_penalty", fu.low_clearance_penalty, 0.0, 100.0);
   f.get("cost_budget", fu.cost_budget, 1000, 100000000);

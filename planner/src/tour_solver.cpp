@@ -177,6 +177,17 @@ Tour solve_tour(const std::vector<std::vector<double>>& cost, int exact_max) {
   return t;
 }
 
+double latency_cost(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight) {
+  double t = 0.0, sum = 0.0;
+  int at = 0;
+  for (const int v : order) {
+    t += p.at(at, v);
+    sum += weight[static_cast<std::size_t>(v)] * t;
+    at = v;
+  }
+  return sum;
+}
+
 double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector<int>& order) {
   double c = 0.0;
   for (std::size_t i = 1; i < order.size(); ++i)

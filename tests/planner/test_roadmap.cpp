@@ -299,12 +299,14 @@ TEST(Collision, EdgesKeepTheClearanceAllAlong) {
   for (double dx = -0.3; dx < 0.1; dx += 0.003) {
     for (double deg = 30.0; deg <= 80.0; deg += 5.0) {
       const double th = deg * core::kPi / 180.0;
-      const Eigen::Vector3d a(2.9 + dx, 2.7, 1.2), b = a + 1.5 * Eigen::Vector3d(-std::cos(th), -std::sin(th), 0.0);
+      const Eigen::Vector3d a(2.9 + dx, 2.7, 1.2),
+          b = a + 1.5 * Eigen::Vector3d(-std::cos(th), -std::sin(th), 0.0);
       if (!c.edge_free(a, b)) continue;
       ++passed;
       for (double t = 0; t <= 1.0; t += 0.0002) {
         const Eigen::Vector3d p = a + t * (b - a);
-        const bool overlaps = p.x() + 0.25 > 2.9 && p.x() - 0.25 < 3.1 && p.y() + 0.25 > 1.9 && p.y() - 0.25 < 2.1;
+        const bool overlaps =
+            p.x() + 0.25 > 2.9 && p.x() - 0.25 < 3.1 && p.y() + 0.25 > 1.9 && p.y() - 0.25 < 2.1;
         ASSERT_FALSE(overlaps) << "dx " << dx << " at " << deg << " deg: " << p.transpose();
       }
     }

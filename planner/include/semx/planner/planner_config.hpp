@@ -390,6 +390,13 @@ struct FuelConfig {
   double covered_fraction = 0.2;
   double replan_period = 1.5;  // s, 0: no periodic replan
   double switch_margin = 0.1;
+  // Not FUEL's (false: its shortest tour): order the tour's clusters for the time at which their
+  // frontier is seen, not for the tour's length: the order of least sum of each viewpoint's
+  // coverage times its arrival time (a weighted minimum-latency tour), found by Or-opt and 2-opt
+  // moves from the shortest tour, at most latency_evaluations orders judged. A shortest tour may
+  // leave the largest cluster for last; 85 % and 95 % come from the large ones.
+  bool latency_tour = false;
+  int latency_evaluations = 3000;
   // The grid search (grid_search.hpp): coarse cells of search_step voxels for travel costs, and
   // how much more a step costs where the clearance is below collision.passage_clearance.
   int search_step = 2;

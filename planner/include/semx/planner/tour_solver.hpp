@@ -29,6 +29,10 @@ struct Tour {
 
 // The cost of visiting `order` from node 0.
 double open_path_cost(const TourProblem& p, const std::vector<int>& order);
+// The weighted latency of visiting `order` from node 0: the sum over its nodes of weight[node]
+// times the cost of the path up to that node (what a tour that should see the most soonest
+// minimises, where open_path_cost is the time to see everything).
+double latency_cost(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight);
 // The best open tour; with `first` >= 1 the tour must visit that node first.
 Tour solve_open_tour(const TourProblem& p, int exact_max, int first = -1);
 // The two methods on their own (tests compare them with brute force).
