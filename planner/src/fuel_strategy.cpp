@@ -382,8 +382,11 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     // With latency_tour, a tour's cost is its weighted latency (each site weighs what its
     // representative viewpoint covers), found from the shortest tour by local moves; the order
     // that keeps the target keeps it first and orders the rest so.
-    std::vector<double> weight(static_cast<size_t>(n), 0.0);
-    for (int i = 0; i < n - 1; ++i) weight[static_cast<size_t>(i + 1)] = rep_view(i).coverage;
+    std::vector<double> weight;
+    if (f.latency_tour) {
+      weight.assign(static_cast<size_t>(n), 0.0);
+      for (int i = 0; i < n - 1; ++i) weight[static_cast<size_t>(i + 1)] = rep_view(i).coverage;
+    }
     auto by_latency = [&](Tour t, bool keep_first) {
       if (t.order.size() < 2) {
         t.cost = latency_cost(problem, t.order, weight);

@@ -109,6 +109,8 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.covered_fraction);
   SAME(fuel.replan_period);
   SAME(fuel.switch_margin);
+  SAME(fuel.latency_tour);
+  SAME(fuel.latency_evaluations);
   SAME(fuel.search_step);
   SAME(fuel.low_clearance_penalty);
   SAME(fuel.cost_budget);
