@@ -20,14 +20,17 @@
 // compares planners seed by seed.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <functional>
+#include <iomanip>
+#include <iostream>
 #include <memory>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -155,11 +158,42 @@ std::vector<map::VoxelKey> object_surface(const SyntheticWorld& world, const Syn
         for (int32_t x = lo.x; x <= hi.x; ++x) {
           const map::VoxelKey k{x, y, z};
           const Eigen::Vector3d c = km.center(k);
-          if (((c.array() + half) <= b.min.array()).any() || ((c.array() - half) >= b.max.array()).any()) continue;
+          if (((c.array() + half) <= b.min.array()).any() || ((c.array() - half) >= b.max.array()).any())
+            continue;
           if (world.occupied(k) && truth.target(k) && seen.insert(k).second) keys.push_back(k);
         }
   }
   return keys;
+}
+
+// The objects' surface voxels seen, in all and by height (0.5 m bands from 0, the last one open):
+// where Time_o's 75 % waits (docs/evaluation.md, "What Time_o is made of").
+struct ObjectsSeen {
+  int64_t seen = 0;
+  std::array<int64_t, 5> band_all{}, band_unseen{};
+  std::string describe(size_t total) const {
+    std::ostringstream o;
+    o << std::fixed << std::setprecision(1)
+      << 100.0 * static_cast<double>(seen) / static_cast<double>(std::max<size_t>(1, total))
+      << " % seen; unseen/all by height 0-0.5/0.5-1/1-1.5/1.5-2/2+ m:";
+    for (size_t b = 0; b < band_all.size(); ++b) o << ' ' << band_unseen[b] << '/' << band_all[b];
+    return o.str();
+  }
+};
+ObjectsSeen objects_seen(const map::StateGrid& known, const std::vector<map::VoxelKey>& keys) {
+  ObjectsSeen s;
+  map::StateGrid::Reader rd = known.reader();
+  const map::KeyMath& km = known.keys();
+  for (const map::VoxelKey& k : keys) {
+    const size_t b = static_cast<size_t>(std::clamp(static_cast<int>(std::floor(km.center(k).z() / 0.5)), 0,
+                                                    static_cast<int>(s.band_all.size()) - 1));
+    ++s.band_all[b];
+    if (rd.state(k) == map::VoxelState::kUnknown)
+      ++s.band_unseen[b];
+    else
+      ++s.seen;
+  }
+  return s;
 }
 
 #ifdef SEMX_PERF_WITH_SIMULATOR
@@ -206,8 +240,11 @@ int main(int argc, char** argv) {
     std::string semantics_config, out_dir;
     std::vector<std::string> overrides;
     ArgParser p("semx-perf-planner", "Planning cycle time over whole explorations of synthetic worlds.");
-    p.option("world", "NAME", "apartment (default), two_rooms, env1, env2, env3, or a world file (semx-world gen)", &world_name)
-        .option("planner", "NAME", "semantic-dep (default), dep, nbv, aep, fuel, oracle (reads the world's truth)",
+    p.option("world", "NAME",
+             "apartment (default), two_rooms, env1, env2, env3, or a world file (semx-world gen)",
+             &world_name)
+        .option("planner", "NAME",
+                "semantic-dep (default), dep, nbv, aep, fuel, oracle (reads the world's truth)",
                 &planner_name)
         .option("samples", "N", "sampling density (default: config, 45)", &samples)
         .option("seed", "N", "first seed (runs use seed, seed+1, ...)", &seed)
@@ -227,12 +264,14 @@ int main(int argc, char** argv) {
         .flag("oracle-interiors", "voxels inside the world's objects are unobservable from the start",
               &oracle)
         .flag("kernels", "time the gain and ESDF kernels on the first run's final map", &kernels)
-        .flag("semantics", "emulated semantics with the semantics module's class table (weights, radii)", &semantics)
+        .flag("semantics", "emulated semantics with the semantics module's class table (weights, radii)",
+              &semantics)
         .option("semantics-config", "FILE", "semantics YAML for --semantics (default: the built-in defaults)",
                 &semantics_config)
         .flag("time-split", "print where each run's time went: new space, revisits, turns, hover, end game",
               &time_split)
-        .option("out", "DIR", "write each run's folder under DIR/runs/ (metrics.json, ...) for semx-bench-report",
+        .option("out", "DIR",
+                "write each run's folder under DIR/runs/ (metrics.json, ...) for semx-bench-report",
                 &out_dir);
     if (!p.parse(argc, argv)) return 0;
     // run_time_to_85 is read off these samples, so without them the figure would silently be -1.
@@ -250,7 +289,8 @@ int main(int argc, char** argv) {
       if (!semantics_config.empty()) sc = load_config<semx::semantics::SemanticsConfig>(semantics_config, {});
       region_params = [regions = sc.regions](int cls, const Eigen::Vector3d& extent, double* w, double* r) {
         const auto c = static_cast<semx::runtime::SemanticClass>(cls);
-        if (cls <= 0 || cls >= static_cast<int>(semx::runtime::SemanticClass::kCount) || !regions.of(c).enabled)
+        if (cls <= 0 || cls >= static_cast<int>(semx::runtime::SemanticClass::kCount) ||
+            !regions.of(c).enabled)
           return false;
         *w = semx::semantics::region_weight(regions, c);
         *r = semx::semantics::region_radius(regions, c, extent);
@@ -301,6 +341,7 @@ int main(int argc, char** argv) {
       // on whole seconds as before. The objects' surface voxels in T (the evaluator's Time_o).
       const std::vector<semx::map::VoxelKey> object_voxels = object_surface(*world, truth);
       double t_cov_next = 0.0, t85 = -1.0, t95 = -1.0, t_o = -1.0;
+      ObjectsSeen objects_at_95;
       std::vector<std::pair<double, double>> t_curve;
       semx::core::TimeSplit split;
       int64_t known_at_path = 0;
@@ -310,25 +351,28 @@ int main(int argc, char** argv) {
           const bool whole = std::abs(t_cov_next - std::round(t_cov_next)) < 1e-6;
           t_cov_next += 0.5;
           const int64_t covered = truth.covered(sim.known());
-          const double cov = static_cast<double>(covered) / static_cast<double>(std::max<int64_t>(1, truth.target_count()));
+          const double cov =
+              static_cast<double>(covered) / static_cast<double>(std::max<int64_t>(1, truth.target_count()));
           split.on_covered(t, covered);
           t_curve.emplace_back(t, cov);
           if (whole) {
             if (t85 < 0 && cov >= 0.85) t85 = t;
-            if (t95 < 0 && cov >= 0.95) t95 = t;
+            if (t95 < 0 && cov >= 0.95) {
+              t95 = t;
+              objects_at_95 = objects_seen(sim.known(), object_voxels);
+            }
             if (t_o < 0 && !object_voxels.empty()) {
-              semx::map::StateGrid::Reader rd = sim.known().reader();
-              int64_t seen = 0;
-              for (const auto& k : object_voxels) seen += rd.state(k) != semx::map::VoxelState::kUnknown;
-              if (static_cast<double>(seen) >= 0.75 * static_cast<double>(object_voxels.size())) t_o = t;
+              const ObjectsSeen o = objects_seen(sim.known(), object_voxels);
+              if (static_cast<double>(o.seen) >= 0.75 * static_cast<double>(object_voxels.size())) t_o = t;
             }
           }
         }
         if (verbose && out.path) {
           // What the goal just left behind added to the map: a goal's promise against its yield.
           const int64_t known = sim.known().known_voxels();
-          std::printf("path t=%.2f grew=%lld known=%lld T=%.3f %%\n", t, static_cast<long long>(known - known_at_path),
-                      static_cast<long long>(known), 100.0 * truth.coverage(sim.known()));
+          std::printf("path t=%.2f grew=%lld known=%lld T=%.3f %%\n", t,
+                      static_cast<long long>(known - known_at_path), static_cast<long long>(known),
+                      100.0 * truth.coverage(sim.known()));
           known_at_path = known;
         }
         if (verbose && out.status && out.status->iteration > 0) {
@@ -338,16 +382,16 @@ int main(int argc, char** argv) {
               "settled=%lld charged=%.1fms %s\n",
               t, static_cast<long long>(s.iteration), to_string(s.state), s.num_nodes, s.counters.total_ms,
               s.counters.sample_ms, s.counters.connect_ms, s.counters.gain_ms, s.counters.search_ms,
-              static_cast<long long>(s.counters.gain_evaluations), static_cast<long long>(s.counters.search_settled),
-              1e3 * s.charged_s, s.reason.c_str());
+              static_cast<long long>(s.counters.gain_evaluations),
+              static_cast<long long>(s.counters.search_settled), 1e3 * s.charged_s, s.reason.c_str());
         }
       });
       if (kernels && run == 0) time_kernels(sim.known(), c);
       if (const auto* os = dynamic_cast<const OracleStrategy*>(&planner.strategy())) {
         const auto [t_share, obs_share] = os->coverage(sim.known());
         std::printf("oracle: %s\n", os->summary().describe().c_str());
-        std::printf("oracle_viewpoints_flown: %zu of %zu (%lld skipped)\n", os->next_viewpoint(), os->tour().size(),
-                    static_cast<long long>(os->skipped()));
+        std::printf("oracle_viewpoints_flown: %zu of %zu (%lld skipped)\n", os->next_viewpoint(),
+                    os->tour().size(), static_cast<long long>(os->skipped()));
         std::printf("oracle_coverage_of_observable: %.2f %%\n", 100.0 * obs_share);
         std::printf("oracle_coverage_of_T: %.2f %%\n", 100.0 * t_share);
       }
@@ -373,9 +417,15 @@ int main(int argc, char** argv) {
       std::printf("run_end_game: %.1f s of %.1f s (settled at %.1f s, coverage %.2f %%)\n",
                   r.time_s - r.time_settled, r.time_s, r.time_settled, 100.0 * r.coverage);
       const double final_t = truth.coverage(sim.known());
-      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * final_t, t85,
-                  t95, r.time_s);
+      std::printf("run_T_coverage: %.2f %% (85 %% at %.0f s, 95 %% at %.0f s, end %.1f s)\n", 100.0 * final_t,
+                  t85, t95, r.time_s);
       std::printf("run_T_time_o: %.0f s (75 %% of %zu object surface voxels)\n", t_o, object_voxels.size());
+      if (!object_voxels.empty()) {
+        if (t95 >= 0)
+          std::printf("run_T_objects_at_95: %s\n", objects_at_95.describe(object_voxels.size()).c_str());
+        std::printf("run_T_objects_at_end: %s\n",
+                    objects_seen(sim.known(), object_voxels).describe(object_voxels.size()).c_str());
+      }
       split.on_covered(r.time_s, truth.covered(sim.known()));
       double settled = r.time_s;
       for (const auto& [t, c] : t_curve) {
@@ -385,12 +435,14 @@ int main(int argc, char** argv) {
         }
       }
       // One line per run for scripts: the evaluator's figures on T.
-      std::printf("run_summary: world=%s planner=%s seed=%lld T=%.3f t85=%.1f t95=%.1f settled=%.1f time_f=%.1f "
-                  "end_game=%.1f distance=%.2f collisions=%lld done=%d\n",
-                  world->name().c_str(), c.planner.c_str(), static_cast<long long>(c.seed), 100.0 * final_t, t85,
-                  t95, settled, r.time_s, r.time_s - settled, r.distance, static_cast<long long>(r.collisions),
-                  r.done ? 1 : 0);
-      const semx::core::TimeSplitResult ts = split.finish(r.time_s, settled, resolution * resolution * resolution);
+      std::printf(
+          "run_summary: world=%s planner=%s seed=%lld T=%.3f t85=%.1f t95=%.1f settled=%.1f time_f=%.1f "
+          "end_game=%.1f distance=%.2f collisions=%lld done=%d\n",
+          world->name().c_str(), c.planner.c_str(), static_cast<long long>(c.seed), 100.0 * final_t, t85, t95,
+          settled, r.time_s, r.time_s - settled, r.distance, static_cast<long long>(r.collisions),
+          r.done ? 1 : 0);
+      const semx::core::TimeSplitResult ts =
+          split.finish(r.time_s, settled, resolution * resolution * resolution);
       if (!out_dir.empty()) {
 #ifdef SEMX_PERF_WITH_EVALUATOR
         namespace ev = semx::evaluator;
@@ -433,8 +485,9 @@ int main(int argc, char** argv) {
         ev::write_run_metrics(dir, s);
 #ifdef SEMX_PERF_WITH_SIMULATOR
         if (g_sim_world)
-          ev::time_split_picture(sim.known(), *g_sim_world, nullptr, ts,
-                                 "where the time went: " + world->name() + ", " + c.planner + " (closed loop)")
+          ev::time_split_picture(
+              sim.known(), *g_sim_world, nullptr, ts,
+              "where the time went: " + world->name() + ", " + c.planner + " (closed loop)")
               .write_png(dir + "/time_split.png");
 #endif
 #else
@@ -446,8 +499,8 @@ int main(int argc, char** argv) {
         for (int u = 0; u < semx::core::kTimeUses; ++u)
           std::printf(" %s %.1f s %.1f m", semx::core::to_string(static_cast<semx::core::TimeUse>(u)),
                       ts.time_s[static_cast<size_t>(u)], ts.distance_m[static_cast<size_t>(u)]);
-        std::printf(" | revisit_by_place %.1f m of %.1f m, time_f %.1f s, settled %.1f s\n", ts.revisit_by_place_m,
-                    ts.distance_total_m, ts.time_f, ts.time_settled);
+        std::printf(" | revisit_by_place %.1f m of %.1f m, time_f %.1f s, settled %.1f s\n",
+                    ts.revisit_by_place_m, ts.distance_total_m, ts.time_f, ts.time_settled);
       }
       if (r.time_85 >= 0) {
         time_85 += r.time_85;
@@ -467,7 +520,8 @@ int main(int argc, char** argv) {
       paths += r.paths;
       done += r.done ? 1 : 0;
       if (verbose) {
-        for (const auto& [t, c] : r.coverage_curve) std::printf("coverage_at %.1f s: %.2f %%\n", t, 100.0 * c);
+        for (const auto& [t, c] : r.coverage_curve)
+          std::printf("coverage_at %.1f s: %.2f %%\n", t, 100.0 * c);
       }
       if (verbose)
         std::printf("run %lld: %s after %.1f s: %s\n", static_cast<long long>(run),
