@@ -28,7 +28,7 @@ constexpr int kAttempts = 3;
 // A cluster without viewpoints is sampled again after this many cycles, this many per cycle.
 constexpr int64_t kResampleCycles = 8;
 constexpr int kResampleClusters = 3;
-constexpr int kLookTurns = 4;  // quarter turns in place at most before the first tour goal
+constexpr int kLookTurns = 4;       // quarter turns in place at most before the first tour goal
 constexpr double kSameView = 0.05;  // m and rad: a replanned view this near the target's is the same
 
 const std::vector<Viewpoint> kNoViews;
@@ -385,7 +385,15 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     std::vector<double> weight;
     if (f.latency_tour) {
       weight.assign(static_cast<size_t>(n), 0.0);
-      for (int i = 0; i < n - 1; ++i) weight[static_cast<size_t>(i + 1)] = rep_view(i).coverage;
+      for (int i = 0; i < n - 1; ++i) {
+        double w = rep_view(i).coverage;
+        if (f.latency_gain) {
+          const NodeGain g = gains_.evaluate(*ctx.grid, rep_view(i).position);
+          w = gains_.gain_at_yaw(g, rep_view(i).yaw);
+        }
+        weight[static_cast<size_t>(i + 1)] =
+            latency_weight(ctx, *clusters_.find(sites_[static_cast<size_t>(i)].cluster), w);
+      }
     }
     auto by_latency = [&](Tour t, bool keep_first) {
       if (t.order.size() < 2) {

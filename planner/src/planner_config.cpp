@@ -205,6 +205,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("switch_margin", fu.switch_margin, 0.0, 1.0);
   f.get("latency_tour", fu.latency_tour);
   f.get("latency_evaluations", fu.latency_evaluations, 1, 1000000);
+  f.get("latency_gain", fu.latency_gain);
   f.get("search_step", fu.search_step, 1, 8);
   f.get("low_clearance_penalty", fu.low_clearance_penalty, 0.0, 100.0);
   f.get("cost_budget", fu.cost_budget, 1000, 100000000);
@@ -245,6 +246,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   sf.get("doorway_radius", c.semantic_fuel.doorway_radius, 0.0, 10.0);
   sf.get("door_clusters", c.semantic_fuel.door_clusters);
   sf.get("dep_first_s", c.semantic_fuel.dep_first_s, 0.0, 1e6);
+  sf.get("object_weight", c.semantic_fuel.object_weight, 0.0, 1e6);
+  sf.get("door_weight", c.semantic_fuel.door_weight, 0.0, 1e6);
 }
 
 }  // namespace semx::planner

@@ -47,6 +47,19 @@ bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<Semantic
   return false;
 }
 
+double share_near_unfinished_objects(const std::vector<map::VoxelKey>& voxels, const map::KeyMath& keys,
+                                     const std::vector<SemanticRegion>& regions, double margin,
+                                     size_t samples) {
+  if (voxels.empty() || samples == 0) return 0.0;
+  const size_t stride = std::max<size_t>(1, (voxels.size() + samples - 1) / samples);
+  size_t tested = 0, near = 0;
+  for (size_t i = 0; i < voxels.size(); i += stride) {
+    ++tested;
+    if (near_unfinished_object(keys.center(voxels[i]), regions, margin)) ++near;
+  }
+  return static_cast<double>(near) / static_cast<double>(tested);
+}
+
 bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius) {
   const int door = static_cast<int>(runtime::SemanticClass::kDoor);
   for (const SemanticRegion& r : regions) {
@@ -96,6 +109,20 @@ void SemanticFuelStrategy::add_tour_costs(const PlanContext& ctx, const GridSear
 }  // namespace semx::planner
 
 namespace semx::planner {
+
+double SemanticFuelStrategy::latency_weight(const PlanContext& ctx, const FrontierClusters::Cluster& cluster,
+                                            double coverage) const {
+  if (!ctx.regions || ctx.regions->empty()) return coverage;
+  double factor = 1.0;
+  // 64 voxels spread over the cluster give its share to a few per cent, at a cost per plan that
+  // does not grow with the cluster.
+  if (rules_.object_weight > 0)
+    factor += rules_.object_weight * share_near_unfinished_objects(cluster.voxels, ctx.grid->keys(),
+                                                                   *ctx.regions, rules_.object_margin, 64);
+  if (rules_.door_weight > 0 && near_door(cluster.mean, *ctx.regions, rules_.doorway_radius))
+    factor += rules_.door_weight;
+  return coverage * factor;
+}
 
 bool SemanticFuelStrategy::promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const {
   if (!ctx.regions) return false;

@@ -111,6 +111,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.switch_margin);
   SAME(fuel.latency_tour);
   SAME(fuel.latency_evaluations);
+  SAME(fuel.latency_gain);
   SAME(fuel.search_step);
   SAME(fuel.low_clearance_penalty);
   SAME(fuel.cost_budget);
@@ -124,6 +125,8 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(semantic_fuel.doorway_first_cost);
   SAME(semantic_fuel.doorway_radius);
   SAME(semantic_fuel.dep_first_s);
+  SAME(semantic_fuel.object_weight);
+  SAME(semantic_fuel.door_weight);
 #undef SAME
 }
 

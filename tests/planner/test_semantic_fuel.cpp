@@ -101,6 +101,42 @@ TEST(SemanticFuel, WithoutAnUnfinishedObjectAtThePocketItFliesFuelsTour) {
   }
 }
 
+TEST(SemanticFuel, TheObjectWeightPutsThePocketFirstInTheLatencyTour) {
+  // The latency tour weighs each site by what it covers: the pocket's few voxels wait for the
+  // second room even when pockets are toured with the large clusters.
+  auto first = [](bool active, double object_weight) {
+    PocketScene s;
+    s.config.fuel.latency_tour = true;
+    s.config.semantic_fuel.object_weight = object_weight;
+    s.regions = {s.cabinet(active)};
+    SemanticFuelStrategy sem(s.config);
+    return s.first_site(sem);
+  };
+  PocketScene ref;
+  EXPECT_FALSE(ref.at_pocket(first(true, 0.0))) << "the scene is meant to leave the pocket for later";
+  EXPECT_TRUE(ref.at_pocket(first(true, 1000.0))) << "an unfinished object's pocket weighs more";
+  EXPECT_FALSE(ref.at_pocket(first(false, 1000.0))) << "a fully observed object weighs nothing more";
+}
+
+TEST(SemanticFuel, TheShareNearUnfinishedObjectsCountsTheSampledVoxels) {
+  const map::KeyMath km(0.1);
+  SemanticRegion r;
+  r.class_id = static_cast<int>(runtime::SemanticClass::kTable);
+  r.centroid = Eigen::Vector3d(1.0, 1.0, 0.4);
+  r.extent = Eigen::Vector3d(0.4, 0.4, 0.8);
+  const std::vector<SemanticRegion> regions{r};
+  std::vector<map::VoxelKey> voxels;
+  for (int i = 0; i < 40; ++i) voxels.push_back(km.key(Eigen::Vector3d(0.05 + 0.1 * i, 1.0, 0.4)));
+  // The centres x = 0.55 ... 1.45 m lie within 0.3 m of the box (0.8-1.2 m): 10 of the 40 voxels.
+  EXPECT_DOUBLE_EQ(share_near_unfinished_objects(voxels, km, regions, 0.3, 64), 0.25);
+  // Every 4th voxel (10 tested): x = 0.05, 0.45, ... 3.65; 0.85 and 1.25 are near.
+  EXPECT_DOUBLE_EQ(share_near_unfinished_objects(voxels, km, regions, 0.3, 10), 0.2);
+  EXPECT_DOUBLE_EQ(share_near_unfinished_objects({}, km, regions, 0.3, 64), 0.0);
+  std::vector<SemanticRegion> done = regions;
+  done[0].active = false;
+  EXPECT_DOUBLE_EQ(share_near_unfinished_objects(voxels, km, done, 0.3, 64), 0.0);
+}
+
 // A door region: its centroid (the open leaf's) at `at`.
 SemanticRegion door_at(const Eigen::Vector3d& at) {
   return region(runtime::SemanticClass::kDoor, at, {0.05, 0.9, 2.0});

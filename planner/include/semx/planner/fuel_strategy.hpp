@@ -85,6 +85,12 @@ class FuelStrategy : public Strategy {
   virtual bool promoted(const PlanContext& /*ctx*/, const FrontierClusters::Cluster& /*cluster*/) const {
     return false;
   }
+  // ... and with fuel.latency_tour, the weight of a site in the tour's latency (FUEL's tour has
+  // none; the latency tour's is what the representative viewpoint covers, `coverage`).
+  virtual double latency_weight(const PlanContext& /*ctx*/, const FrontierClusters::Cluster& /*cluster*/,
+                                double coverage) const {
+    return coverage;
+  }
 
  private:
   struct ClusterState {
@@ -145,9 +151,9 @@ class FuelStrategy : public Strategy {
   std::vector<Banned> blacklist_;
   Target target_;
   bool switch_ = false;
-  Goal look_;              // the turn in place being flown (before the first tour goal)
-  int looks_ = 0;          // turns made so far
-  bool toured_ = false;    // a tour goal was chosen once
+  Goal look_;            // the turn in place being flown (before the first tour goal)
+  int looks_ = 0;        // turns made so far
+  bool toured_ = false;  // a tour goal was chosen once
   std::string replan_reason_;
   // This plan's sites and tour (for the roadmap view).
   std::vector<Site> sites_;

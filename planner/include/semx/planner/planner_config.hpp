@@ -226,6 +226,14 @@ struct SemanticFuelConfig {
   // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
   // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
   double dep_first_s = 0.0;
+  // With fuel.latency_tour: what an object not yet fully observed is worth in the tour's order. A
+  // site's weight (its coverage) is multiplied by 1 + object_weight × the share of its cluster's
+  // voxels within object_margin of such an object's box, so the tour sees the unseen sides of
+  // objects sooner without touring anything it would not. 0: the latency tour's weights.
+  double object_weight = 0.0;
+  // ... and a door region means a room behind it: a site whose cluster's mean lies within
+  // doorway_radius of a door weighs 1 + door_weight times its coverage. 0: off.
+  double door_weight = 0.0;
 };
 
 // The main loop: when to replan, when to give up.
@@ -397,6 +405,10 @@ struct FuelConfig {
   // leave the largest cluster for last; 85 % and 95 % come from the large ones.
   bool latency_tour = false;
   int latency_evaluations = 3000;
+  // The latency tour's weight of a site: false, what its representative viewpoint covers of the
+  // cluster's frontier; true, the volumetric gain G from there in its yaw window (DEP's measure:
+  // the unknown space a visit reveals, which a room behind a small doorway frontier has much of).
+  bool latency_gain = false;
   // The grid search (grid_search.hpp): coarse cells of search_step voxels for travel costs, and
   // how much more a step costs where the clearance is below collision.passage_clearance.
   int search_step = 2;

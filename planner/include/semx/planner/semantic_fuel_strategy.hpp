@@ -42,6 +42,8 @@ class SemanticFuelStrategy : public FuelStrategy {
                       const std::vector<Eigen::Vector3d>& reps, const std::vector<Eigen::Vector3d>& means,
                       TourProblem& problem) const override;
   bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
+  double latency_weight(const PlanContext& ctx, const FrontierClusters::Cluster& cluster,
+                        double coverage) const override;
 
  private:
   SemanticFuelConfig rules_;
@@ -63,6 +65,12 @@ std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& pat
 // is still active (not fully observed) and has an extent.
 bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions,
                             double margin);
+
+// The share of `voxels` (at most `samples` of them, spread over the list) whose centres lie within
+// `margin` of the box of an unfinished object (near_unfinished_object); 0 when `voxels` is empty.
+double share_near_unfinished_objects(const std::vector<map::VoxelKey>& voxels, const map::KeyMath& keys,
+                                     const std::vector<SemanticRegion>& regions, double margin,
+                                     size_t samples);
 
 // Whether `p` lies within `radius` (horizontally) of a door region's centroid.
 bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius);
