@@ -378,7 +378,9 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
     const int limit = o.unreachable_informative > 0
                           ? std::max(config_.loop.done_cycles, config_.loop.max_recovery_cycles)
                           : config_.loop.done_cycles;
-    next = no_goal_cycles_ >= limit || o.finished ? PlannerState::kDone : PlannerState::kRecovering;
+    next = (no_goal_cycles_ >= limit && iteration_ > o.skipped_until) || o.finished
+               ? PlannerState::kDone
+               : PlannerState::kRecovering;
     reason = next == PlannerState::kDone ? o.reason : why + ": " + o.reason;
   } else {
     next = PlannerState::kExecuting;

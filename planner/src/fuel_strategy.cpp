@@ -175,6 +175,15 @@ void FuelStrategy::update_clusters(PlanContext& ctx) {
   ctx.counters->gain_ms += w.ms();
 }
 
+int64_t FuelStrategy::ban_end(const Eigen::Vector3d& p, int64_t cycle) const {
+  int64_t end = -1;
+  for (const Banned& b : blacklist_) {
+    if (b.until_cycle >= cycle && (b.position - p).norm() < config_.fuel.min_view_distance)
+      end = std::max(end, b.until_cycle);
+  }
+  return end;
+}
+
 bool FuelStrategy::blacklisted(const Eigen::Vector3d& p, int64_t cycle) const {
   for (const Banned& b : blacklist_) {
     if (b.until_cycle >= cycle && (b.position - p).norm() < config_.fuel.min_view_distance) return true;
@@ -284,6 +293,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
                                                              int64_t* waiting) {
   const FuelConfig& f = config_.fuel;
   const CostConfig& cost = config_.cost;
+  skipped_until_ = -1;
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
     sites_.clear();
     tour_.clear();
@@ -301,7 +311,14 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         owner.emplace_back(id, static_cast<int>(v));
         ++taken;
       }
-      if (taken == 0) ++banned_only;
+      if (taken == 0) {
+        // Every view of the cluster is banned: it is free again when its first ban ends, and the
+        // plan can wait for the first cluster that is.
+        ++banned_only;
+        int64_t free_at = std::numeric_limits<int64_t>::max();
+        for (const Viewpoint& vp : cs.views) free_at = std::min(free_at, ban_end(vp.position, ctx.cycle));
+        skipped_until_ = skipped_until_ < 0 ? free_at : std::min(skipped_until_, free_at);
+      }
     }
     core::Stopwatch sw;
     const GridSearch::Result field = search_.distances(vehicle_, true, targets, kMaxFieldCells, true);
@@ -647,6 +664,7 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     }
     out.reason = reason;
     out.unreachable_informative = waiting;
+    out.skipped_until = skipped_until_;
     return finish();
   }
   toured_ = true;

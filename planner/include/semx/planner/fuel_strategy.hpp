@@ -125,6 +125,8 @@ class FuelStrategy : public Strategy {
   void update_clusters(PlanContext& ctx);
   bool eligible(const PlanContext& ctx, const map::VoxelKey& k) const;
   bool blacklisted(const Eigen::Vector3d& p, int64_t cycle) const;
+  // The last cycle of the bans on p (-1 when none is in force).
+  int64_t ban_end(const Eigen::Vector3d& p, int64_t cycle) const;
   // Steps 3-6; `keep` (a cluster id or -1): also the cost of the best tour visiting it first.
   std::optional<Planned> plan_tour(PlanContext& ctx, int64_t keep, double* keep_cost, std::string* reason,
                                    int64_t* waiting);
@@ -151,9 +153,10 @@ class FuelStrategy : public Strategy {
   std::vector<Banned> blacklist_;
   Target target_;
   bool switch_ = false;
-  Goal look_;            // the turn in place being flown (before the first tour goal)
-  int looks_ = 0;        // turns made so far
-  bool toured_ = false;  // a tour goal was chosen once
+  Goal look_;                   // the turn in place being flown (before the first tour goal)
+  int looks_ = 0;               // turns made so far
+  bool toured_ = false;         // a tour goal was chosen once
+  int64_t skipped_until_ = -1;  // this plan's PlanOutcome::skipped_until
   std::string replan_reason_;
   // This plan's sites and tour (for the roadmap view).
   std::vector<Site> sites_;

@@ -82,6 +82,12 @@ struct PlanOutcome {
   // No goal, but roadmap nodes with gain exist that the vehicle cannot reach (the graph came
   // apart, e.g. edges through a doorway were pruned): worth recovering longer before DONE.
   int64_t unreachable_informative = 0;
+  // No goal only because every informative goal left is skipped for now (one the controller
+  // rejected, one just reached: Strategy::reject_goal): the last cycle of those skips, -1 when
+  // none. The main loop does not declare DONE before it has planned once after it: a skip is a
+  // pause, not a verdict (FUEL in env3 with sensor noise ended DONE at 65 % when its skips and
+  // the recovery cycles ran out in the same cycle).
+  int64_t skipped_until = -1;
   // Nothing is left to do at all (the oracle flew its last viewpoint): DONE at once, without the
   // done_cycles of cycles that look for a goal again.
   bool finished = false;
