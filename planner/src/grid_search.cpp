@@ -570,7 +570,10 @@ bool GridSearch::find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, c
   const int64_t s = l.nx > 0 ? l.index(lattice_of(l, a)) : -1;
   const int64_t goal = l.nx > 0 ? l.index(lattice_of(l, b)) : -1;
   if (s < 0 || goal < 0) return false;
-  const bool escape = cls(l, s) == kBlocked;
+  // The vehicle itself may lack the clearance its voxel's centre has: held by the controller 0.337 m
+  // from a wall (sensor noise, env3), every path from its voxel's centre failed the first segment's
+  // check, the vehicle stayed there for 350 s and its viewpoints were skipped one by one.
+  const bool escape = cls(l, s) == kBlocked || !checker_.passage_free(a);
   // A straight line first (FUEL's ViewNode::searchPath), when the start has the clearance (else
   // the escape rule would let the whole first metre pass unknown voxels).
   if (!escape && checker_.edge_free(a, b) && body_clear(a, b)) {

@@ -19,6 +19,7 @@
 
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
+#include "semx/planner/grid_search.hpp"
 #include "semx/planner/planner_config.hpp"
 #include "semx/runtime/args.hpp"
 #include "semx/runtime/config.hpp"
@@ -168,7 +169,7 @@ void probe(const map::StateGrid& grid, const planner::CollisionChecker& checker,
 int main(int argc, char** argv) {
   return runtime::run_main("semx-planner-probe", [&] {
     std::string map_file, config_file;
-    std::vector<std::string> doors, overrides, edges;
+    std::vector<std::string> doors, overrides, edges, paths;
     runtime::ArgParser p("semx-planner-probe",
                          "Prints the planner's collision checks around doorways of a run's map.bt.");
     p.positional("MAP", "an OctoMap .bt (a run folder's map.bt, or semx-map-replay's)", &map_file)
@@ -176,7 +177,9 @@ int main(int argc, char** argv) {
         .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
         .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors)
         .repeated("edge", "AX,AY,AZ,BX,BY,BZ", "one edge: what each check says about it and its ends",
-                  &edges);
+                  &edges)
+        .repeated("path", "AX,AY,AZ,BX,BY,BZ", "FUEL's grid search from A to B: the coarse distance and the path",
+                  &paths);
     if (!p.parse(argc, argv)) return 0;
     const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
     map::StateGrid grid(0.1);
@@ -215,7 +218,36 @@ int main(int argc, char** argv) {
       std::printf("edge: edge_free %d, root_edge_free %d\n", checker.edge_free(a, b),
                   checker.root_edge_free(a, b));
     }
-    if (!edges.empty() && list.empty()) return 0;
+    for (const std::string& s : paths) {
+      Eigen::Vector3d a, b;
+      std::istringstream in(s);
+      char c;
+      if (!(in >> a.x() >> c >> a.y() >> c >> a.z() >> c >> b.x() >> c >> b.y() >> c >> b.z())) {
+        std::cerr << "bad --path " << s << "\n";
+        return 2;
+      }
+      // The searches FuelStrategy::plan_tour makes: the coarse field from the vehicle (its escape
+      // rule on), then A* along its path, then anywhere.
+      planner::GridSearch search(checker, config.collision, config.fuel.search_step, config.fuel.low_clearance_penalty);
+      search.set_grid(&grid);
+      const planner::GridSearch::Result field = search.distances(a, true, {b}, 4000000, true);
+      std::printf("path: coarse distance %.2f m (%lld cells settled)\n", field.distance[0],
+                  static_cast<long long>(field.settled));
+      std::vector<Eigen::Vector3d> out;
+      int64_t expanded = 0;
+      const std::vector<Eigen::Vector3d> guide = search.tree_path(b);
+      bool found = search.find_path(a, b, guide, 200000, out, &expanded);
+      std::printf("path: along the coarse path (%zu points): %s, %lld voxels expanded\n", guide.size(),
+                  found ? "found" : "none", static_cast<long long>(expanded));
+      if (!found) {
+        expanded = 0;
+        found = search.find_path(a, b, {}, 200000, out, &expanded);
+        std::printf("path: anywhere: %s, %lld voxels expanded\n", found ? "found" : "none",
+                    static_cast<long long>(expanded));
+      }
+      for (const Eigen::Vector3d& q : out) std::printf("  (%.2f %.2f %.2f)\n", q.x(), q.y(), q.z());
+    }
+    if ((!edges.empty() || !paths.empty()) && list.empty()) return 0;
     if (list.empty()) {
       list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'}, {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
               {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'}, {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};
