@@ -496,6 +496,17 @@ TEST(Viewpoints, TheCameraDoesNotSeeThroughWalls) {
 
 // ---------------------------------------------------------------- yaws
 
+TEST(Fuel, LongSegmentsAreSplitBelowTheControllersLimit) {
+  const std::vector<Eigen::Vector3d> path = {{0, 0, 1}, {2, 0, 1}, {2, 11.8, 1}, {2, 12.5, 1}};
+  const std::vector<Eigen::Vector3d> out = split_long_segments(path, 9.0);
+  ASSERT_EQ(out.size(), 5u);  // the 11.8 m segment in two halves
+  EXPECT_EQ(out.front(), path.front());
+  EXPECT_EQ(out.back(), path.back());
+  EXPECT_TRUE(out[2].isApprox(Eigen::Vector3d(2, 5.9, 1)));
+  for (size_t i = 1; i < out.size(); ++i) EXPECT_LE((out[i] - out[i - 1]).norm(), 9.0);
+  EXPECT_EQ(split_long_segments({{0, 0, 1}, {3, 4, 1}}, 9.0).size(), 2u) << "short segments stay";
+}
+
 TEST(Fuel, YawsTurnTowardTheGoalAsFastAsTheRateAllows) {
   const std::vector<Eigen::Vector3d> w = {{0, 0, 1}, {0.5, 0, 1}, {1.0, 0, 1}, {4.0, 0, 1}};
   const std::vector<double> y = turn_early_yaws(w, 0.0, 2.0, 1.0, 1.0);

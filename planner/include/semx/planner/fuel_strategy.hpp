@@ -175,6 +175,11 @@ class FuelStrategy : public Strategy {
   double first_leg(double distance, const Eigen::Vector3d& p, double yaw) const;
 };
 
+// `waypoints` with points added evenly on every segment longer than `max_length` (m), so that no
+// segment is: the controller rejects a path with a segment longer than its max_segment_length
+// (10 m), and FUEL's straight line of sight to a viewpoint across a long room can be longer.
+std::vector<Eigen::Vector3d> split_long_segments(const std::vector<Eigen::Vector3d>& waypoints, double max_length);
+
 // Yaws for a path flown by FUEL: from `start_yaw` toward `goal_yaw` (the shorter way) as fast as
 // `yaw_rate` allows at `velocity` along the path, so the camera looks at the goal's cluster as
 // early as it can; the last waypoint has goal_yaw.
