@@ -63,6 +63,13 @@ Eigen::Vector3d at(const Door& d, double along, double across, double z) {
                        : Eigen::Vector3d(d.x + across, d.y + along, z);
 }
 
+// "AX,AY,AZ,BX,BY,BZ" (--edge, --path).
+bool parse_points(const std::string& s, Eigen::Vector3d& a, Eigen::Vector3d& b) {
+  std::istringstream in(s);
+  char c;
+  return static_cast<bool>(in >> a.x() >> c >> a.y() >> c >> a.z() >> c >> b.x() >> c >> b.y() >> c >> b.z());
+}
+
 void probe(const map::StateGrid& grid, const planner::CollisionChecker& checker, const Door& d) {
   const double res = grid.resolution();
   std::printf("== doorway (%.2f, %.2f) wall along %c\n", d.x, d.y, d.axis);
@@ -199,9 +206,7 @@ int main(int argc, char** argv) {
     }
     for (const std::string& s : edges) {
       Eigen::Vector3d a, b;
-      std::istringstream in(s);
-      char c;
-      if (!(in >> a.x() >> c >> a.y() >> c >> a.z() >> c >> b.x() >> c >> b.y() >> c >> b.z())) {
+      if (!parse_points(s, a, b)) {
         std::cerr << "bad --edge " << s << "\n";
         return 2;
       }
@@ -220,9 +225,7 @@ int main(int argc, char** argv) {
     }
     for (const std::string& s : paths) {
       Eigen::Vector3d a, b;
-      std::istringstream in(s);
-      char c;
-      if (!(in >> a.x() >> c >> a.y() >> c >> a.z() >> c >> b.x() >> c >> b.y() >> c >> b.z())) {
+      if (!parse_points(s, a, b)) {
         std::cerr << "bad --path " << s << "\n";
         return 2;
       }

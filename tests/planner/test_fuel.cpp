@@ -622,14 +622,18 @@ TEST(Fuel, AStartFacingAWallTurnsInPlaceInsteadOfEndingDone) {
   }
 }
 
+// SyntheticWorld::two_rooms known up to 1.5 m into the second room (x 0-4 and 4.2-8.2, y 0-4).
+void reveal_first_room(PlanScene& s) {
+  SyntheticWorld::two_rooms().reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
+  s.frontiers.reset(s.grid);
+}
+
 // A target that counts as covered while its cluster stays (its voxels found unobservable, which
 // changes no cluster) is planned again at once; when the plan chooses the same view, the goal
 // being flown stays (goal_score answers), instead of a new path to the same place every cycle.
 TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
   PlanScene s("fuel");
-  const SyntheticWorld w = SyntheticWorld::two_rooms();
-  w.reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
-  s.frontiers.reset(s.grid);
+  reveal_first_room(s);
   FuelStrategy fuel(s.config);
   PlanContext ctx = s.context({1.6, 2.4, 1.2});
   ctx.need_goal = true;
@@ -671,9 +675,7 @@ TEST(Fuel, DeclaresDoneOnAFullyKnownMap) {
 // has no goal, says which cycle the first skip that frees a cluster ends, and plans again after it.
 TEST(Fuel, AllViewpointsSkippedSaysWhenTheSkipsEnd) {
   PlanScene s("fuel");
-  const SyntheticWorld w = SyntheticWorld::two_rooms();
-  w.reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
-  s.frontiers.reset(s.grid);
+  reveal_first_room(s);
   FuelStrategy fuel(s.config);
   PlanContext ctx = s.context({1.6, 2.4, 1.2});
   ctx.need_goal = true;
