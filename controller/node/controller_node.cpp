@@ -76,7 +76,7 @@ int ControllerNode::run() {
             << c.fallback_strays << ", too close " << c.fallback_too_close << "), squared headings "
             << c.squared_headings << ", repaired headings " << c.repaired_headings << ", rejected "
             << c.rejected << ", unsafe " << c.unsafe << ", brakes " << c.brakes << ", stale stops "
-            << c.stale_stops << std::endl;
+            << c.stale_stops << ", off track " << c.off_track << std::endl;
   return code;
 }
 

@@ -32,6 +32,10 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
   const bool footprint = rule.footprint_half_xy > 0.0 && !trajectory.yaw.empty();
   double start = 0.0;
   bool escaping = false;
+  // Below hard_bound at the start: the floor rises with the arc length from the start's value.
+  bool contact = false;
+  double contact_floor = 0.0, arc = 0.0;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
   // How far below the turned body's reach a sample may be: a start already below it (the vehicle
   // stands there), or the sample where an escape from the bound ends, may move out of it, never
   // deeper, as an escape from the bound may.
@@ -52,16 +56,23 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
       start = d;
       escaping = low < rule.bound;
       r.escaping = escaping;
-      if (escaping && (!rule.allow_escape || low < rule.hard_bound)) {
+      contact = escaping && low < rule.hard_bound;
+      contact_floor = low - rule.escape_slack;
+      if (escaping && (!rule.allow_escape || (contact && !(rule.contact_rise > 0.0)))) {
         fail(t, p, d);
         return r;
       }
+    } else {
+      arc += (p - previous).norm();
     }
+    previous = p;
+    const double floor =
+        contact ? std::min(rule.hard_bound, contact_floor + rule.contact_rise * arc) : rule.hard_bound;
     if (escaping) {
       if (low >= rule.bound) {
         escaping = false;  // out: from here on the full bound applies
         reach_escape_may_start = true;
-      } else if (low < rule.hard_bound || d < start - rule.escape_slack) {
+      } else if (low < floor || d < start - rule.escape_slack) {
         fail(t, p, d);
         return r;
       }

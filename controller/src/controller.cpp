@@ -171,6 +171,12 @@ StepOutput Controller::step(int64_t now) {
     }
     status_.tracking_rms =
         error_count_ > 0 ? std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)) : 0.0;
+    const double lag = status_.tracking_error;
+    if (config_.safety.max_tracking_error > 0.0 && lag > config_.safety.max_tracking_error) {
+      ++counters_.off_track;
+      stop(ControllerState::kBraking, core::short_number(lag) + " m from its reference (blocked or lagging)");
+      out.command = TrackingController::hover(hover_yaw());
+    }
   } else {
     out.command = TrackingController::hover(hover_yaw());
   }

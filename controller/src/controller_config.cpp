@@ -23,6 +23,7 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   cl.get("square_headings", c.clearance.square_headings);
   cl.get("heading_repairs", c.clearance.heading_repairs, 0, 100);
   cl.get("heading_hold", c.clearance.heading_hold, 0.01, 10.0);
+  cl.get("square_fallback", c.clearance.square_fallback);
   cl.get("check_spacing", c.clearance.check_spacing, 0.001, 0.5);
   cl.get("allow_escape", c.clearance.allow_escape);
   std::string outside = c.clearance.outside_is_obstacle ? "obstacle" : "free";
@@ -65,6 +66,7 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   s.get("check_horizon", c.safety.check_horizon, 0.0, 3600.0);
   s.get("max_odometry_age", c.safety.max_odometry_age, 0.0, 3600.0);
   s.get("max_esdf_age", c.safety.max_esdf_age, 0.0, 3600.0);
+  s.get("max_tracking_error", c.safety.max_tracking_error, 0.0, 100.0);
 }
 
 }  // namespace semx::controller

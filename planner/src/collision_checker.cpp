@@ -535,16 +535,24 @@ bool CollisionChecker::samples_free(const Eigen::Vector3d& a, const Eigen::Vecto
   // the controller's measure) than the root itself, and farther than the body's half width. A
   // vehicle that braked with its box's corner touching a voxel of a door leaf was otherwise cut off
   // from every node, 0.17 m away or not, and DONE at 39 % (env3, dep, seed 4, at 26 s).
-  const double floor = escape_radius > 0 ? std::max(vehicle_half_.x(),
-                                                    esdf(a, config_.passage_clearance, false) - kEscapeSlack)
-                                         : 0.0;
-  const auto escapes = [&](const Eigen::Vector3d& p) {
-    return vehicle_free(p) || esdf(p, config_.passage_clearance, false) >= floor;
+  // A root below the half width (its body touches, or its box overlaps the voxels of what it
+  // touches) may leave as the controller lets it (ClearanceRule::contact_rise): its floor starts
+  // at the root's own value and rises by kContactRise per metre until the half width, so the edge
+  // moves away and never along the obstacle. A vehicle that touched a chair (ESDF 0.207 m) had no
+  // edge and no path for the 225 s left of its run (env3, fuel's latency tour, seed 1).
+  const double root_value = escape_radius > 0 ? esdf(a, config_.passage_clearance, false) : 0.0;
+  const bool contact = escape_radius > 0 && root_value < vehicle_half_.x();
+  const double floor = escape_radius > 0 ? std::max(vehicle_half_.x(), root_value - kEscapeSlack) : 0.0;
+  const auto escapes = [&](const Eigen::Vector3d& p, double s) {
+    if (vehicle_free(p)) return true;
+    const double need =
+        contact ? std::min(vehicle_half_.x(), root_value - kEscapeSlack + kContactRise * s) : floor;
+    return esdf(p, config_.passage_clearance, false) >= need;
   };
   // 2: the stretch of `half` around s keeps passage_clearance; 1: door_clearance; 0: neither.
   auto level = [&](double s, double half) {
     const Eigen::Vector3d p = at(s);
-    if (escape_radius > 0 && s < escape_radius) return escapes(p) ? 2 : 0;
+    if (escape_radius > 0 && s < escape_radius) return escapes(p, s) ? 2 : 0;
     const double v = esdf(p, config_.passage_clearance + slope * half);
     if (v >= config_.passage_clearance + slope * half && region_free(p, body_half_, 0.0, true)) return 2;
     // Doorway level: door_clearance as the controller sees it, to occupied voxels only, and

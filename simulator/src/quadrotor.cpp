@@ -164,8 +164,7 @@ StepReport Quadrotor::step(double dt) {
   const double yaw = core::wrap_angle(prev.yaw + 0.5 * (prev.yaw_rate + yaw_rate) * dt);
 
   const int hit = body_hit(p, yaw);
-  if (hit >= 0) {
-    // Stop at the last free pose instead of entering the solid.
+  const auto touch = [&] {
     report.blocked = true;
     report.solid = hit;
     report.collision_start = !in_contact_;
@@ -173,6 +172,21 @@ StepReport Quadrotor::step(double dt) {
     ++blocked_steps_;
     in_contact_ = true;
     contact_solid_ = hit;
+  };
+  if (hit >= 0 && yaw != prev.yaw && body_hit(p, prev.yaw) < 0) {
+    // The solid stops the turn, not a move away from it: a body touching a wall with a corner
+    // could never leave when every step also turned that corner into the wall (the step was
+    // refused whole and the velocity zeroed, so the next step was as small).
+    touch();
+    state_.position = p;
+    state_.velocity = v;
+    state_.acceleration = (v - prev.velocity) / dt;
+    state_.yaw_rate = 0;
+    return report;
+  }
+  if (hit >= 0) {
+    // Stop at the last free pose instead of entering the solid.
+    touch();
     state_.velocity.setZero();
     state_.yaw_rate = 0;
     state_.acceleration = -prev.velocity / dt;

@@ -78,10 +78,20 @@ TEST(BodyHeading, TheFallbackThroughATightPointKeepsTheTurnedBodyOffTheEdge) {
   EXPECT_TRUE(check_clearance(r.trajectory, field, 0, r.trajectory.duration(), body).ok);
 
   cfg.clearance.square_headings = false;
+  cfg.clearance.square_fallback = false;
   const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
   ASSERT_TRUE(plain.ok) << plain.reason;
   EXPECT_EQ(plain.squared_headings, 0);
+  EXPECT_EQ(plain.repaired_headings, 0);
   EXPECT_FALSE(check_clearance(plain.trajectory, field, 0, plain.trajectory.duration(), body).ok);
+
+  // Without the squared path point, the held heading (square_fallback) keeps the body off too.
+  cfg.clearance.square_fallback = true;
+  const GenerationResult held = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(held.ok) << held.reason;
+  EXPECT_EQ(held.squared_headings, 0);
+  EXPECT_GE(held.repaired_headings, 1);
+  EXPECT_TRUE(check_clearance(held.trajectory, field, 0, held.trajectory.duration(), body).ok);
 }
 
 TEST(BodyHeading, HoldingTheHeadingSquareReplacesTheKnotsAroundTheInstant) {

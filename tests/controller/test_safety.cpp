@@ -115,6 +115,77 @@ TEST(Clearance, AStartWithinTheTurnedBodysReachMayMoveOutOfItButNotDeeper) {
   EXPECT_FALSE(check_clearance(back, post, 0, back.duration(), rule).ok);
 }
 
+TEST(Clearance, AStartTouchingAWallMayLeaveOnlyMovingAway) {
+  // A wall at x >= 2.2, the vehicle 0.2 m from it: below the hard bound (0.25 m), its body in
+  // contact. It may leave when its distance rises by contact_rise per metre of arc until the hard
+  // bound; sliding along the wall, or with contact_rise 0, it may not.
+  const auto field = boxes_field({{Eigen::Vector3d(2.2, -5, 0), Eigen::Vector3d(3.0, 5, 3)}});
+  ClearanceRule rule;
+  rule.bound = 0.32;
+  rule.hard_bound = 0.25;
+  const Eigen::Vector3d start(2.0, 0, 1);
+  ASSERT_LT(field->distance(start), rule.hard_bound);
+  const Trajectory away = straight(start, {0.5, 0, 1}, 3.0);
+  EXPECT_TRUE(check_clearance(away, *field, 0, away.duration(), rule).ok);
+  const Trajectory slanted = straight(start, {0.8, -1.2, 1}, 3.0);  // 45° off the wall
+  EXPECT_TRUE(check_clearance(slanted, *field, 0, slanted.duration(), rule).ok);
+  const Trajectory along = straight(start, {2.0, -2, 1}, 3.0);
+  const ClearanceReport r = check_clearance(along, *field, 0, along.duration(), rule);
+  EXPECT_FALSE(r.ok);
+  const Trajectory grazing = straight(start, {1.8, -2, 1}, 3.0);  // 6° off the wall
+  EXPECT_FALSE(check_clearance(grazing, *field, 0, grazing.duration(), rule).ok);
+  rule.contact_rise = 0.0;
+  EXPECT_FALSE(check_clearance(away, *field, 0, away.duration(), rule).ok);
+  rule.contact_rise = 0.5;
+  rule.allow_escape = false;
+  EXPECT_FALSE(check_clearance(away, *field, 0, away.duration(), rule).ok);
+}
+
+TEST(Safety, AVehicleHeldFarFromItsReferenceBrakesInsteadOfChasingIt) {
+  // The vehicle is held where it is (a wall it touches stops every step): the reference runs on,
+  // and once it is max_tracking_error ahead the controller stops and says so; the planner plans
+  // again from where the vehicle is. Free, the same flight never comes near that error.
+  ControllerConfig cfg;
+  for (const bool held : {false, true}) {
+    Loop loop(cfg, boxes_field({}));
+    loop.vehicle.position = Eigen::Vector3d(0, 0, 1);
+    loop.run(0.1);
+    loop.send_path({{0, 0, 1}, {6, 0, 1}}, {0, 0}, 3);
+    loop.run(0.5);
+    ASSERT_EQ(loop.controller.status().state, ControllerState::kTracking);
+    double worst = 0.0;
+    for (int i = 0; i < 300 && loop.controller.status().state == ControllerState::kTracking; ++i) {
+      const Eigen::Vector3d p = loop.vehicle.position;
+      loop.step();
+      worst = std::max(worst, loop.last.status.tracking_error);
+      if (held) loop.vehicle.position = p, loop.vehicle.velocity.setZero();
+    }
+    if (!held) {
+      EXPECT_LT(worst, 0.2);
+      EXPECT_EQ(loop.controller.counters().off_track, 0);
+      continue;
+    }
+    EXPECT_EQ(loop.controller.status().state, ControllerState::kBraking);
+    EXPECT_NE(loop.controller.status().reason.find("from its reference"), std::string::npos)
+        << loop.controller.status().reason;
+    EXPECT_EQ(loop.controller.counters().off_track, 1);
+    EXPECT_EQ(loop.last.command.mode, Command::Mode::kHold);
+    EXPECT_LE(worst, cfg.safety.max_tracking_error + 0.02);
+  }
+  cfg.safety.max_tracking_error = 0.0;  // off: it chases on
+  Loop off(cfg, boxes_field({}));
+  off.vehicle.position = Eigen::Vector3d(0, 0, 1);
+  off.run(0.1);
+  off.send_path({{0, 0, 1}, {6, 0, 1}}, {0, 0}, 3);
+  for (int i = 0; i < 250; ++i) {
+    const Eigen::Vector3d p = off.vehicle.position;
+    off.step();
+    off.vehicle.position = p, off.vehicle.velocity.setZero();
+  }
+  EXPECT_EQ(off.controller.status().state, ControllerState::kTracking);
+  EXPECT_EQ(off.controller.counters().off_track, 0);
+}
+
 TEST(Safety, BrakesOnAPredictedCollisionAndSaysWhy) {
   ControllerConfig cfg;
   auto free_field = boxes_field({});

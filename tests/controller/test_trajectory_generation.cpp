@@ -433,16 +433,32 @@ TEST(TrajectoryGeneration, OnlyOptimisedCurvesAnswerForTheTurnedBody) {
   EXPECT_EQ(TrajectoryGenerator(cfg).generation_rule(true).footprint_half_xy, 0.0);
 
   // A straight path 0.36 m beside a post, heading 45° off the way: the path itself (the
-  // fallback, exactly on it) is flown; its corner would reach 0.354 m toward the post.
+  // fallback, exactly on it) is flown; its corner would reach 0.354 m toward the post. Its heading
+  // is held square to the post where that keeps the corner off (square_fallback); where it cannot
+  // (no repairs allowed), or with square_fallback off, it is flown as it is.
   cfg.clearance.turned_body = true;
   cfg.optimizer.max_iterations = 0;
   const std::vector<Eigen::Vector3d> line = {{0, 0, 1}, {4, 0, 1}};
   const PostField post(Eigen::Vector2d(2.0, 0.36));
-  const GenerationResult r =
+  const ClearanceRule turned = TrajectoryGenerator(cfg).generation_rule(true);
+  const GenerationResult held =
       TrajectoryGenerator(cfg).generate(line, {M_PI / 4, M_PI / 4}, at_rest(line[0]), 0.0, post);
-  ASSERT_TRUE(r.ok) << r.reason;
-  EXPECT_FALSE(r.trajectory.optimized);
-  ClearanceRule turned = TrajectoryGenerator(cfg).generation_rule(true);
-  EXPECT_FALSE(check_clearance(r.trajectory, post, 0, r.trajectory.duration(), turned).ok)
-      << "the same curve, had it been optimised, would not be flown";
+  ASSERT_TRUE(held.ok) << held.reason;
+  EXPECT_FALSE(held.trajectory.optimized);
+  EXPECT_GE(held.repaired_headings, 1);
+  EXPECT_TRUE(check_clearance(held.trajectory, post, 0, held.trajectory.duration(), turned).ok);
+  for (const bool no_repairs : {true, false}) {
+    ControllerConfig c = cfg;
+    if (no_repairs)
+      c.clearance.heading_repairs = 0;
+    else
+      c.clearance.square_fallback = false;
+    const GenerationResult r =
+        TrajectoryGenerator(c).generate(line, {M_PI / 4, M_PI / 4}, at_rest(line[0]), 0.0, post);
+    ASSERT_TRUE(r.ok) << r.reason;
+    EXPECT_FALSE(r.trajectory.optimized);
+    EXPECT_EQ(r.repaired_headings, 0);
+    EXPECT_FALSE(check_clearance(r.trajectory, post, 0, r.trajectory.duration(), turned).ok)
+        << "the same curve, had it been optimised, would not be flown";
+  }
 }

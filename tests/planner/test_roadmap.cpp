@@ -354,6 +354,26 @@ TEST(Collision, ARootWhoseBoxCornerTouchesAVoxelMayMoveAwayFromIt) {
   EXPECT_FALSE(c.edge_free(root, {1.5, 1.2, 1.2})) << "only the root escapes";
 }
 
+TEST(Collision, ARootTouchingAnObstacleMayLeaveOnlyMovingAway) {
+  // A column 0.2 m from the root in the ESDF, below the half width (0.25 m): the body touched a
+  // chair and stayed there, with no edge and no path for 225 s (env3, fuel's latency tour, seed 1).
+  // It may leave when each point within the escape radius is farther than the root by half its
+  // distance from it (kContactRise), up to the half width; not along the obstacle.
+  map::StateGrid g = known_room();
+  fill_m(g, {3.2, 1.5, 0.0}, {3.3, 2.5, 2.5}, VoxelState::kOccupied);
+  CollisionChecker c(CollisionConfig{});
+  c.set_grid(&g);
+  const Eigen::Vector3d root(3.0, 2, 1.2);
+  const double touching = c.esdf(root, 0.42, false);
+  ASSERT_LT(touching, 0.25);
+  ASSERT_GT(touching, 0.1);
+  EXPECT_TRUE(c.root_edge_free(root, {1.5, 2.0, 1.2})) << "straight away";
+  EXPECT_TRUE(c.root_edge_free(root, {1.5, 1.2, 1.2})) << "away at 29° off the normal";
+  EXPECT_FALSE(c.root_edge_free(root, {3.0, 0.5, 1.2})) << "along the obstacle";
+  EXPECT_FALSE(c.root_edge_free(root, {2.9, 0.2, 1.2})) << "nearly along it";
+  EXPECT_FALSE(c.edge_free(root, {1.5, 2.0, 1.2})) << "only the root escapes";
+}
+
 // DEP's roadmap over cycles on a partly known map.
 struct DepFixture : PlanScene {
   DepFixture() : PlanScene("dep", 7) {}

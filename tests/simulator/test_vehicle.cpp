@@ -178,6 +178,34 @@ TEST(Quadrotor, CollisionStopsTheVehicleAndIsCountedOnce) {
   }
 }
 
+TEST(Quadrotor, ATurnIntoASolidDoesNotStopAMoveAwayFromIt) {
+  // The body, turned 22.5°, touches a wall with a corner; the command moves it away while turning
+  // that corner into the wall. The wall stops the turn, not the move: refusing the whole step (and
+  // zeroing the velocity) had held a vehicle there for seconds (env3, fuel's latency tour, seed 1).
+  World w = test::box_room(6, 4, 3);
+  w.start.position = {1, 2, 1.2};
+  w.start.yaw = M_PI / 8;
+  w.solids.push_back(Solid::box(SemanticClass::kWall, {3, 2, 1.35}, {0.1, 3.8, 2.7}));
+  Quadrotor q(w, VehicleConfig{});
+  ASSERT_TRUE(q.command(ControlCommand::velocity_yaw({0.5, 0, 0}, M_PI / 8)).accepted);
+  for (int i = 0; i < 5000; ++i) q.step(kDt);
+  ASSERT_EQ(q.collisions(), 1);
+  const VehicleState touching = q.state();
+  // A corner turned 22.5° reaches 0.25 (cos 22.5° + sin 22.5°) = 0.327 m.
+  ASSERT_NEAR(touching.position.x(), 2.95 - 0.327, 0.02);
+  // Away along -x while the heading turns to 45° (which swings the corner further toward +x).
+  ASSERT_TRUE(q.command(ControlCommand::velocity_yaw({-0.3, 0, 0}, M_PI / 4)).accepted);
+  for (int i = 0; i < 1000; ++i) {
+    q.step(kDt);
+    ASSERT_FALSE(body_in_any_solid(w, q.state())) << "step " << i;
+  }
+  EXPECT_LT(q.state().position.x(), touching.position.x() - 0.1) << "it moved away";
+  EXPECT_EQ(q.collisions(), 1) << "one contact";
+  // Far enough, the turn is free again.
+  for (int i = 0; i < 3000; ++i) q.step(kDt);
+  EXPECT_NEAR(q.state().yaw, M_PI / 4, 0.05);
+}
+
 TEST(Imu, NoiseDensityAndGravity) {
   ImuConfig c;
   ImuModel imu(c, 3);

@@ -21,6 +21,13 @@ struct ClearanceRule {
   bool allow_escape = true;    // a start below `bound` may climb out without getting closer
   double escape_slack = 0.01;  // m, how much closer than its start an escape may wobble
   bool require_exit = true;    // an escape must reach the bound before t1 (off for a horizon)
+  // m per m of arc: a start below hard_bound (the body touches, or nearly: the map's voxels
+  // overstate obstacles by up to a voxel) may escape too, when its distance rises by at least this
+  // along the curve until it reaches hard_bound, so it moves away at 30° or more and never slides
+  // along the obstacle. Without it a vehicle that touched a chair had every trajectory refused and
+  // hovered there for the 225 s left of its run (env3, fuel's latency tour, seed 1). 0: no such
+  // escape.
+  double contact_rise = 0.5;
   // The body box, turned by the trajectory's yaw: outside an escape, a sample also needs the box's
   // reach toward its nearest obstacle (the support along the ESDF gradient) plus footprint_margin.
   // 0 = off. `bound` assumes a face toward the obstacle; a corner reaches up to √2 farther.

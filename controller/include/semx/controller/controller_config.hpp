@@ -56,6 +56,9 @@ struct ClearanceConfig {
   // most heading_repairs times (body_heading.hpp), before the slower curves are tried. 0: off.
   int heading_repairs = 8;
   double heading_hold = 0.3;    // s
+  // The fallback's heading held square the same way where its turned body would touch, when that
+  // is enough; otherwise it is flown as it is (its bound is the planner's, see turned_body).
+  bool square_fallback = true;
   double check_spacing = 0.02;  // m, arc length between dense clearance samples
   // A trajectory that starts below the bound (the vehicle already is) may climb out of it
   // without getting closer than its start; otherwise such a vehicle could never move again.
@@ -122,6 +125,12 @@ struct SafetyConfig {
   double check_horizon = 2.0;     // s of the flown trajectory checked against each new ESDF
   double max_odometry_age = 0.2;  // s of message time; older odometry stops the vehicle
   double max_esdf_age = 1.0;      // s of message time; an older ESDF stops the vehicle
+  // m: a vehicle this far from its reference brakes (BRAKING, so the planner plans again from
+  // where it is) instead of chasing it across the path's corners. Held 2.6 s by a wall it touched
+  // (every step turned its corner into it), the vehicle then flew at the command limit (1.5 m/s)
+  // straight for a reference 2 m ahead, below the path's climb, into a chair (env3, fuel's latency
+  // tour, seed 1, at 175 s). Tracking errors are a few cm in flight. 0: off.
+  double max_tracking_error = 0.5;
 };
 
 struct ControllerConfig {

@@ -33,6 +33,7 @@ struct ControllerCounters {
   int64_t squared_headings = 0;    // path points whose heading was turned to face an obstacle
   int64_t repaired_headings = 0;   // instants of flown optimised curves whose heading was held square
   int64_t brakes = 0;              // predicted collisions
+  int64_t off_track = 0;           // stops farther than safety.max_tracking_error from the reference
   int64_t stale_stops = 0;         // entries into STALE_INPUT
 };
 

@@ -14,9 +14,10 @@
 //   root_edge_free(root, b): edge_free when the root itself is node_free; otherwise points within
 //                    root_escape_radius of the root are checked with the bare vehicle box against
 //                    occupied voxels only, or, where that box overlaps one, with the ESDF: no
-//                    closer than the root, farther than the half width: the vehicle may leave a
-//                    pose whose surroundings are not mapped yet (the camera never sees the cone
-//                    above and below itself) or that drifted close to a wall.
+//                    closer than the root, farther than the half width (a root below the half
+//                    width: rising from its own value by kContactRise per metre): the vehicle may
+//                    leave a pose whose surroundings are not mapped yet (the camera never sees the
+//                    cone above and below itself), that drifted close to a wall or that touched one.
 //
 // The centre line is first walked voxel by voxel (no occupied or unknown voxel on it), which
 // rejects edges through walls and into unknown space for the price of one ray.
@@ -69,6 +70,9 @@ class CollisionChecker {
   // m: how much closer to the obstacles than the root a point within root_escape_radius may be
   // when its bare box overlaps an occupied voxel (the controller's escape_slack).
   static constexpr double kEscapeSlack = 0.01;
+  // m per m: how fast a root below the half width must move away from the obstacles within
+  // root_escape_radius (the controller's contact_rise: 30° or more off the obstacle's surface).
+  static constexpr double kContactRise = 0.5;
   // Moves p away from the occupied and unknown voxels within `clearance` of it (each pushes by
   // how much it intrudes, along the line from its cube's nearest point), up to `iterations` times
   // and by at most max_step each; true when p ends node_free (passage_free with `passage`).

@@ -67,7 +67,8 @@ struct CommandResult {
 };
 
 struct StepReport {
-  bool blocked = false;          // the move would have entered a solid; the vehicle stopped
+  bool blocked = false;          // the move would have entered a solid; the vehicle stopped (moved
+                                 // without turning when only the turn would have)
   bool collision_start = false;  // first blocked step of a contact (what collisions() counts)
   int solid = -1;                // the solid hit
 };
