@@ -141,6 +141,31 @@ TEST(Clearance, AStartTouchingAWallMayLeaveOnlyMovingAway) {
   EXPECT_FALSE(check_clearance(away, *field, 0, away.duration(), rule).ok);
 }
 
+TEST(Safety, AVehicleTouchingAWallFliesAPathAwayFromIt) {
+  // The whole controller, from a start 0.2 m from a wall (its body touching): the path away is
+  // flown to its end without a brake; a path along the wall is refused.
+  ControllerConfig cfg;
+  const auto wall = boxes_field({{Eigen::Vector3d(2.2, -5, 0), Eigen::Vector3d(3.0, 5, 3)}});
+  Loop loop(cfg, wall);
+  loop.vehicle.position = Eigen::Vector3d(2.0, 0, 1);
+  loop.run(0.1);
+  loop.send_path({{2.0, 0, 1}, {0.5, 0, 1}}, {0, 0}, 1);
+  loop.step();
+  ASSERT_EQ(loop.controller.status().state, ControllerState::kTracking) << loop.controller.status().reason;
+  loop.track_to_end();
+  EXPECT_EQ(loop.controller.status().state, ControllerState::kHolding) << loop.controller.status().reason;
+  EXPECT_EQ(loop.controller.counters().brakes, 0);
+  EXPECT_NEAR(loop.vehicle.position.x(), 0.5, 0.05);
+
+  Loop along(cfg, wall);
+  along.vehicle.position = Eigen::Vector3d(2.0, 0, 1);
+  along.run(0.1);
+  along.send_path({{2.0, 0, 1}, {2.0, -3, 1}}, {0, 0}, 1);
+  along.step();
+  EXPECT_EQ(along.controller.status().state, ControllerState::kRejected);
+  EXPECT_EQ(along.controller.counters().unsafe, 1);
+}
+
 TEST(Safety, AVehicleHeldFarFromItsReferenceBrakesInsteadOfChasingIt) {
   // The vehicle is held where it is (a wall it touches stops every step): the reference runs on,
   // and once it is max_tracking_error ahead the controller stops and says so; the planner plans
