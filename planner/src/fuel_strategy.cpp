@@ -77,6 +77,8 @@ void FuelStrategy::reset() {
   dirty_.clear();
   rebuild_ = true;
   blacklist_.clear();
+  strikes_.clear();
+  cycle_ = 0;
   target_ = Target();
   switch_ = false;
   look_ = Goal();
@@ -330,7 +332,8 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         ++banned_only;
         int64_t free_at = std::numeric_limits<int64_t>::max();
         for (const Viewpoint& vp : cs.views) free_at = std::min(free_at, ban_end(vp.position, ctx.cycle));
-        skipped_until_ = skipped_until_ < 0 ? free_at : std::min(skipped_until_, free_at);
+        if (free_at != kForGood)
+          skipped_until_ = skipped_until_ < 0 ? free_at : std::min(skipped_until_, free_at);
       }
     }
     core::Stopwatch sw;
@@ -598,6 +601,7 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     update_clusters(ctx);
     ctx.counters->sample_ms += w.ms();
   }
+  cycle_ = ctx.cycle;
   blacklist_.erase(std::remove_if(blacklist_.begin(), blacklist_.end(),
                                   [&](const Banned& b) { return b.until_cycle < ctx.cycle; }),
                    blacklist_.end());
@@ -699,6 +703,18 @@ std::optional<double> FuelStrategy::goal_score(PlanContext&, const Goal& goal) {
 }
 
 void FuelStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
+  // Reached again and again (or rejected again) without its cluster going: a view that only
+  // counts voxels it cannot see had a vehicle fly to it, wait out the skip and fly to it again
+  // until the time limit (a 140 m² world, the process set, 100 s at 99.8 %).
+  // A strike is a return after the place's skip ended: places skipped together (every view near
+  // a rejected one) are one.
+  if (!blacklisted(goal.position, cycle_)) {
+    auto it = std::find_if(strikes_.begin(), strikes_.end(), [&](const auto& s) {
+      return (s.first - goal.position).norm() < config_.fuel.min_view_distance;
+    });
+    if (it == strikes_.end()) it = strikes_.insert(strikes_.end(), {goal.position, 0});
+    if (++it->second >= kStrikes) until_cycle = kForGood;
+  }
   blacklist_.push_back({goal.position, until_cycle});
   if (target_.valid && (target_.goal.position - goal.position).norm() < 1e-9) target_.valid = false;
 }

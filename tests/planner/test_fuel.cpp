@@ -704,6 +704,42 @@ TEST(Fuel, AllViewpointsSkippedSaysWhenTheSkipsEnd) {
   EXPECT_EQ(again.skipped_until, -1);
 }
 
+// A place reached again after its skip ended is skipped for good (and so does not hold DONE back): a
+// view whose voxels cannot be seen from it was reached, skipped, chosen and reached again until
+// the time limit (a 140 m² world, the process set, 100 s at 99.8 %).
+TEST(Fuel, APlaceReachedAgainAfterItsSkipIsSkippedForGood) {
+  PlanScene s("fuel");
+  reveal_first_room(s);
+  FuelStrategy fuel(s.config);
+  const auto plan_at = [&](int64_t cycle) {
+    PlanContext ctx = s.context({1.6, 2.4, 1.2}, 0.0, cycle);
+    ctx.need_goal = true;
+    return fuel.plan(ctx);
+  };
+  const PlanOutcome first = plan_at(1);
+  ASSERT_TRUE(first.goal.valid) << first.reason;
+  const Goal g = first.goal;
+  const double near = s.config.fuel.min_view_distance;
+  // Skipped twice while the first skip holds: one strike, so free again when it ends.
+  fuel.reject_goal(g, 10);
+  fuel.reject_goal(g, 10);
+  const PlanOutcome during = plan_at(5);
+  if (during.goal.valid) {
+    EXPECT_GE((during.goal.position - g.position).norm(), near);
+  }
+  const PlanOutcome after = plan_at(11);
+  ASSERT_TRUE(after.goal.valid) << after.reason;
+  EXPECT_LT((after.goal.position - g.position).norm(), near) << "the same place, free again";
+  // Reached again once its skip ended: skipped for good.
+  fuel.reject_goal(after.goal, 20);
+  for (const int64_t cycle : {21, 100, 1000}) {
+    const PlanOutcome later = plan_at(cycle);
+    if (later.goal.valid) {
+      EXPECT_GE((later.goal.position - g.position).norm(), near) << "cycle " << cycle;
+    }
+  }
+}
+
 // ... and the main loop waits for the skips to end instead of declaring DONE when its recovery
 // cycles (loop.max_recovery_cycles) run out first: FUEL in env3 with sensor noise ended DONE at
 // 65 % when both ran out in the same cycle.

@@ -34,6 +34,7 @@
 // what is around the start gives them one.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -151,6 +152,13 @@ class FuelStrategy : public Strategy {
     int64_t until_cycle;
   };
   std::vector<Banned> blacklist_;
+  // Places of goals the main loop reached or the controller rejected, with how many times: the
+  // kStrikes-th time a place is banned for good (its cluster's voxels cannot be seen from there,
+  // or not flown to), and a ban for good does not hold DONE back.
+  std::vector<std::pair<Eigen::Vector3d, int>> strikes_;
+  static constexpr int kStrikes = 2;
+  int64_t cycle_ = 0;  // the cycle of the last plan
+  static constexpr int64_t kForGood = std::numeric_limits<int64_t>::max();
   Target target_;
   bool switch_ = false;
   Goal look_;                   // the turn in place being flown (before the first tour goal)
