@@ -703,15 +703,15 @@ std::optional<double> FuelStrategy::goal_score(PlanContext&, const Goal& goal) {
 }
 
 void FuelStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
-  // Reached again and again (or rejected again) without its cluster going: a view that only
-  // counts voxels it cannot see had a vehicle fly to it, wait out the skip and fly to it again
-  // until the time limit (a 140 m² world, the process set, 100 s at 99.8 %).
-  // A strike is a return after the place's skip ended: places skipped together (every view near
-  // a rejected one) are one.
-  if (!blacklisted(goal.position, cycle_)) {
-    auto it = std::find_if(strikes_.begin(), strikes_.end(), [&](const auto& s) {
-      return (s.first - goal.position).norm() < config_.fuel.min_view_distance;
-    });
+  // Reached again and again without its cluster going: a view that only counts voxels it cannot
+  // see had a vehicle fly to it, wait out the skip and fly to it again until the time limit (a
+  // 140 m² world, the process set, 100 s at 99.8 %). A strike is a visit (the vehicle is there; a
+  // goal given up for a better one or refused by the controller is not) after the place's skip
+  // ended: places skipped together are one.
+  const double near = config_.fuel.min_view_distance;
+  if ((vehicle_ - goal.position).norm() < near && !blacklisted(goal.position, cycle_)) {
+    auto it = std::find_if(strikes_.begin(), strikes_.end(),
+                           [&](const auto& s) { return (s.first - goal.position).norm() < near; });
     if (it == strikes_.end()) it = strikes_.insert(strikes_.end(), {goal.position, 0});
     if (++it->second >= kStrikes) until_cycle = kForGood;
   }

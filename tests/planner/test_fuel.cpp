@@ -711,29 +711,36 @@ TEST(Fuel, APlaceReachedAgainAfterItsSkipIsSkippedForGood) {
   PlanScene s("fuel");
   reveal_first_room(s);
   FuelStrategy fuel(s.config);
-  const auto plan_at = [&](int64_t cycle) {
-    PlanContext ctx = s.context({1.6, 2.4, 1.2}, 0.0, cycle);
+  const Eigen::Vector3d start(1.6, 2.4, 1.2);
+  const auto plan_at = [&](int64_t cycle, const Eigen::Vector3d& at) {
+    PlanContext ctx = s.context(at, 0.0, cycle);
     ctx.need_goal = true;
     return fuel.plan(ctx);
   };
-  const PlanOutcome first = plan_at(1);
+  const PlanOutcome first = plan_at(1, start);
   ASSERT_TRUE(first.goal.valid) << first.reason;
   const Goal g = first.goal;
   const double near = s.config.fuel.min_view_distance;
-  // Skipped twice while the first skip holds: one strike, so free again when it ends.
+  // Given up from afar (not reached) twice: no strike.
+  fuel.reject_goal(g, 2);
+  plan_at(3, start);
+  fuel.reject_goal(g, 4);
+  // Reached, and reached again while the skip holds: one strike, so free again when it ends.
+  plan_at(5, g.position);
   fuel.reject_goal(g, 10);
   fuel.reject_goal(g, 10);
-  const PlanOutcome during = plan_at(5);
+  const PlanOutcome during = plan_at(6, start);
   if (during.goal.valid) {
     EXPECT_GE((during.goal.position - g.position).norm(), near);
   }
-  const PlanOutcome after = plan_at(11);
+  const PlanOutcome after = plan_at(11, start);
   ASSERT_TRUE(after.goal.valid) << after.reason;
   EXPECT_LT((after.goal.position - g.position).norm(), near) << "the same place, free again";
   // Reached again once its skip ended: skipped for good.
+  plan_at(12, after.goal.position);
   fuel.reject_goal(after.goal, 20);
   for (const int64_t cycle : {21, 100, 1000}) {
-    const PlanOutcome later = plan_at(cycle);
+    const PlanOutcome later = plan_at(cycle, start);
     if (later.goal.valid) {
       EXPECT_GE((later.goal.position - g.position).norm(), near) << "cycle " << cycle;
     }

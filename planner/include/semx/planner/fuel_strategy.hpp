@@ -152,9 +152,9 @@ class FuelStrategy : public Strategy {
     int64_t until_cycle;
   };
   std::vector<Banned> blacklist_;
-  // Places of goals the main loop reached or the controller rejected, with how many times: the
-  // kStrikes-th time a place is banned for good (its cluster's voxels cannot be seen from there,
-  // or not flown to), and a ban for good does not hold DONE back.
+  // Places of goals the vehicle reached, with how many times after their skip had ended: the
+  // kStrikes-th time a place is banned for good (its cluster's voxels cannot be seen from there),
+  // and a ban for good does not hold DONE back.
   std::vector<std::pair<Eigen::Vector3d, int>> strikes_;
   static constexpr int kStrikes = 2;
   int64_t cycle_ = 0;  // the cycle of the last plan
