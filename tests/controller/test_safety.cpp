@@ -166,6 +166,12 @@ TEST(Safety, AVehicleTouchingAWallFliesAPathAwayFromIt) {
   EXPECT_EQ(along.controller.counters().unsafe, 1);
 }
 
+// What a solid the body touches does to the vehicle: it stays where it was.
+static void hold(PointMass& vehicle, const Eigen::Vector3d& at) {
+  vehicle.position = at;
+  vehicle.velocity.setZero();
+}
+
 TEST(Safety, AVehicleHeldFarFromItsReferenceBrakesInsteadOfChasingIt) {
   // The vehicle is held where it is (a wall it touches stops every step): the reference runs on,
   // and once it is max_tracking_error ahead the controller stops and says so; the planner plans
@@ -183,7 +189,7 @@ TEST(Safety, AVehicleHeldFarFromItsReferenceBrakesInsteadOfChasingIt) {
       const Eigen::Vector3d p = loop.vehicle.position;
       loop.step();
       worst = std::max(worst, loop.last.status.tracking_error);
-      if (held) loop.vehicle.position = p, loop.vehicle.velocity.setZero();
+      if (held) hold(loop.vehicle, p);
     }
     if (!held) {
       EXPECT_LT(worst, 0.2);
@@ -205,7 +211,7 @@ TEST(Safety, AVehicleHeldFarFromItsReferenceBrakesInsteadOfChasingIt) {
   for (int i = 0; i < 250; ++i) {
     const Eigen::Vector3d p = off.vehicle.position;
     off.step();
-    off.vehicle.position = p, off.vehicle.velocity.setZero();
+    hold(off.vehicle, p);
   }
   EXPECT_EQ(off.controller.status().state, ControllerState::kTracking);
   EXPECT_EQ(off.controller.counters().off_track, 0);
