@@ -302,13 +302,22 @@ map::StateGrid two_known_rooms() {
   return g;
 }
 
-TEST(GridSearch, FindsAPathThroughADoorwayThatPassesTheChecks) {
-  const map::StateGrid g = two_known_rooms();
+// FUEL's grid search and its checker over `g` (two_known_rooms(), changed or not).
+struct RoomsSearch {
+  explicit RoomsSearch(map::StateGrid grid) : g(std::move(grid)) {
+    checker.set_grid(&g);
+    s.set_grid(&g);
+  }
+  map::StateGrid g;
   const PlannerConfig c = test_config("fuel");
-  CollisionChecker checker(c.collision);
-  checker.set_grid(&g);
-  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
-  s.set_grid(&g);
+  CollisionChecker checker{c.collision};
+  GridSearch s{checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty};
+};
+
+TEST(GridSearch, FindsAPathThroughADoorwayThatPassesTheChecks) {
+  RoomsSearch f(two_known_rooms());
+  const CollisionChecker& checker = f.checker;
+  GridSearch& s = f.s;
   const Eigen::Vector3d a(1.5, 0.8, 1.2), b(6.5, 0.8, 1.2);
   const GridSearch::Result r = s.distances(a, true, {b, Eigen::Vector3d(4.0, 0.5, 1.2)}, 1000000, true);
   // Around through the doorway (1.2 m off the straight line each way), not through the wall.
@@ -339,12 +348,10 @@ TEST(GridSearch, FindsAPathThroughADoorwayThatPassesTheChecks) {
 // it: the path leaves by the escape rule (as from a voxel without the clearance) instead of
 // failing its first segment at every replan (env3 with sensor noise: 350 s in one place).
 TEST(GridSearch, AStartCloserToAWallThanItsVoxelsCentreStillLeaves) {
-  const map::StateGrid g = two_known_rooms();
-  const PlannerConfig c = test_config("fuel");
-  CollisionChecker checker(c.collision);
-  checker.set_grid(&g);
-  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
-  s.set_grid(&g);
+  RoomsSearch f(two_known_rooms());
+  const PlannerConfig& c = f.c;
+  const CollisionChecker& checker = f.checker;
+  GridSearch& s = f.s;
   const Eigen::Vector3d b(1.5, 0.8, 1.2);
   int starts = 0;
   for (double x = 3.40; x < 3.65; x += 0.005) {
@@ -363,12 +370,10 @@ TEST(GridSearch, AStartCloserToAWallThanItsVoxelsCentreStillLeaves) {
 
 TEST(GridSearch, ChangesNearACellAreSeenByTheNextSearch) {
   // Close the doorway: the next search finds no way, the cache notwithstanding.
-  map::StateGrid g = two_known_rooms();
-  const PlannerConfig c = test_config("fuel");
-  CollisionChecker checker(c.collision);
-  checker.set_grid(&g);
-  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
-  s.set_grid(&g);
+  RoomsSearch f(two_known_rooms());
+  map::StateGrid& g = f.g;
+  CollisionChecker& checker = f.checker;
+  GridSearch& s = f.s;
   const Eigen::Vector3d a(1.5, 0.8, 1.2), b(6.5, 0.8, 1.2);
   ASSERT_TRUE(s.distances(a, true, {b}, 1000000, false).distance[0] < 1e9);
   std::vector<map::VoxelChange> changes;
@@ -390,14 +395,14 @@ TEST(GridSearch, SpaceSeenFreeOrOccupiedGivesWhatAFreshSearchGives) {
   // unknown space elsewhere. The cached search skips unknown -> occupied changes and keeps its
   // top-class cells near freed voxels: its distances must still be a fresh search's, exactly,
   // also where a wall piece appears in space known free (that lowers top-class cells).
-  map::StateGrid g = two_known_rooms();
-  fill_m(g, {3.9, 1.5, 0.0}, {4.1, 2.5, 2.1}, VoxelState::kUnknown);
-  fill_m(g, {6.0, 2.8, 0.0}, {8.0, 4.0, 2.5}, VoxelState::kUnknown);
-  const PlannerConfig c = test_config("fuel");
-  CollisionChecker checker(c.collision);
-  checker.set_grid(&g);
-  GridSearch s(checker, c.collision, c.fuel.search_step, c.fuel.low_clearance_penalty);
-  s.set_grid(&g);
+  map::StateGrid start = two_known_rooms();
+  fill_m(start, {3.9, 1.5, 0.0}, {4.1, 2.5, 2.1}, VoxelState::kUnknown);
+  fill_m(start, {6.0, 2.8, 0.0}, {8.0, 4.0, 2.5}, VoxelState::kUnknown);
+  RoomsSearch f(std::move(start));
+  map::StateGrid& g = f.g;
+  const PlannerConfig& c = f.c;
+  CollisionChecker& checker = f.checker;
+  GridSearch& s = f.s;
   const Eigen::Vector3d a(1.5, 0.8, 1.2);
   const std::vector<Eigen::Vector3d> targets = {
       {6.5, 0.8, 1.2}, {5.0, 2.5, 1.0}, {7.0, 2.0, 1.5}, {2.0, 3.5, 1.2}, {3.5, 2.0, 1.2}};
