@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <queue>
 #include <sstream>
@@ -476,7 +477,7 @@ DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t i
 }
 
 Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                              int64_t* unreachable, bool sweep, const TierFn* tier) {
+                              int64_t* unreachable, bool sweep, const TierFn* tier, const Goal* flown) {
   {
     core::Stopwatch w;
     search_ = graph_.shortest_paths(root_);
@@ -484,6 +485,11 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ctx.counters->search_ms += w.ms();
   }
   update_region_factors(ctx);
+  // A node must score above this to change what the main loop flies (ctx.flown).
+  double bar = -std::numeric_limits<double>::infinity();
+  if (flown && !tier && !(config_.cost.local_first > 0)) {
+    if (const std::optional<double> current = goal_score(ctx, *flown)) bar = ctx.switch_factor * *current;
+  }
   const size_t slots = graph_.slots().size();
   reward_.assign(slots, 0.0);
   cost_.assign(slots, -1.0);
@@ -535,7 +541,14 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
   // a heading is scored again with the turn its path flies, when it comes to the top; that score
   // is never higher, so the best left is still found first.
   std::set<int64_t> turn_checked;
+  bool below_bar = false;
   while (!queue.empty()) {
+    // Everything left is bounded by the top (a stale gain is taken as an upper bound, as above,
+    // and a held heading's turn only lowers a score): nothing left would make the loop switch.
+    if (std::get<1>(queue.top()) <= bar) {
+      below_bar = true;
+      break;
+    }
     const int64_t id = -std::get<2>(queue.top());
     queue.pop();
     RoadmapNode& n = graph_.node(id);
@@ -580,6 +593,11 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     goal.yaws = std::move(f->yaws);
     break;
   }
+  if (below_bar) {
+    if (unreachable) *unreachable = 0;
+    if (reason) *reason = "no node scores above the flown goal's switch bar";
+    return goal;
+  }
   int64_t cut_off = 0;
   if (!goal.valid) {
     for (const RoadmapNode& n : graph_.slots()) {
@@ -614,8 +632,8 @@ PlanOutcome DepStrategy::plan_with(PlanContext& ctx, const TierFn* tier) {
   bridge(ctx);
 
   PlanOutcome out;
-  out.goal =
-      select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep, tier);
+  out.goal = select_goal(ctx, paper_score(), &out.reason, &out.unreachable_informative, config_.gain.sweep,
+                         tier, config_.loop.pocket_detour > 0 ? nullptr : ctx.flown);
   if (out.goal.valid && in_end_game(ctx)) {
     int stops = 0;
     Goal g = tour_goal(ctx, paper_score(), &stops);

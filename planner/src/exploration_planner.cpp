@@ -323,6 +323,10 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
   }
   controller_trigger_ = controller_rejected_ = false;
   ctx.need_goal = need;
+  if (!need) {
+    ctx.flown = &goal_;
+    ctx.switch_factor = goal_.held ? std::numeric_limits<double>::infinity() : config_.loop.hysteresis;
+  }
 
   const bool run = need || !strategy_->receding_horizon();
   PlanOutcome o;

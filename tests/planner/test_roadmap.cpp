@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <random>
 #include <set>
@@ -827,6 +828,70 @@ TEST(DepRoadmap, AFlyingCycleRefreshesAtMostItsBudgetOfGains) {
   EXPECT_EQ(needed.evaluations, unbounded.evaluations) << "a cycle that needs a goal is not bounded";
   EXPECT_TRUE(needed.goal);
   EXPECT_FALSE(needed.stale_goal);
+}
+
+// ctx.flown: while a goal is flown, the ranking stops once nothing left can score above the
+// switch bar (switch_factor x the flown goal's score). The main loop's decision is the one the
+// whole ranking gives (a goal above the bar, the same; none above it, keep flying), with fewer
+// gain evaluations when the bar stops the ranking early.
+TEST(DepRoadmap, AFlyingCycleStopsRankingBelowTheSwitchBar) {
+  struct Cycle {
+    int64_t evaluations = 0;
+    Goal goal;
+    std::optional<double> flown_score;  // goal_score() of the flown goal after the cycle
+  };
+  auto cycle_after_change = [](const double* switch_factor) {
+    Cycle c;
+    DepFixture f;
+    corridor(f.grid);
+    f.frontiers.reset(f.grid);
+    DepStrategy dep(f.config, false);
+    dep.on_map_reset();
+    PlanContext ctx = f.context({1, 2, 1.2});
+    ctx.need_goal = true;
+    const Goal flown = dep.plan(ctx).goal;
+    EXPECT_TRUE(flown.valid);
+    // Space mapped next to the roadmap makes most of its gains stale.
+    fill_m(f.grid, {6.0, 0.0, 0.0}, {6.5, 4.0, 2.5}, VoxelState::kFree);
+    std::vector<map::VoxelChange> changes;
+    for (double y = 0.05; y < 4.0; y += 0.5)
+      changes.push_back({f.grid.keys().key({6.25, y, 1.0}), VoxelState::kFree});
+    dep.on_map_changes(changes);
+    f.counters = CycleCounters();
+    PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
+    if (switch_factor) {
+      ctx2.flown = &flown;
+      ctx2.switch_factor = *switch_factor;
+    }
+    c.goal = dep.plan(ctx2).goal;
+    c.evaluations = f.counters.gain_evaluations;
+    c.flown_score = dep.goal_score(ctx2, flown);
+    return c;
+  };
+  const Cycle whole = cycle_after_change(nullptr);
+  ASSERT_TRUE(whole.goal.valid);
+  ASSERT_TRUE(whole.flown_score);
+  ASSERT_GT(whole.evaluations, 2);
+  // A held goal (no switch at all): nothing needs ranking, and the stale gains stay stale.
+  const double never = std::numeric_limits<double>::infinity();
+  const Cycle held = cycle_after_change(&never);
+  EXPECT_FALSE(held.goal.valid);
+  EXPECT_LT(held.evaluations, whole.evaluations);
+  // Any goal switches: the whole ranking's answer.
+  const double any = 0.0;
+  const Cycle eager = cycle_after_change(&any);
+  ASSERT_TRUE(eager.goal.valid);
+  EXPECT_EQ(eager.goal.node, whole.goal.node);
+  EXPECT_DOUBLE_EQ(eager.goal.score, whole.goal.score);
+  // Bars just below and just above the whole ranking's best: its goal, then none.
+  const double below = 0.99 * whole.goal.score / *whole.flown_score;
+  const Cycle switches = cycle_after_change(&below);
+  ASSERT_TRUE(switches.goal.valid);
+  EXPECT_EQ(switches.goal.node, whole.goal.node);
+  const double above = 1.01 * whole.goal.score / *whole.flown_score;
+  const Cycle stays = cycle_after_change(&above);
+  EXPECT_FALSE(stays.goal.valid);
+  EXPECT_LE(stays.evaluations, whole.evaluations);
 }
 
 TEST(DepRoadmap, SameSeedSameRoadmap) {

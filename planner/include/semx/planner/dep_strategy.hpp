@@ -100,9 +100,15 @@ class DepStrategy : public Strategy {
   // `tier` (optional): a node of a higher tier outranks every node of a lower one (the ordering
   // rules of semantic_room_strategy.hpp); it is called after the search, so last_search() holds
   // this cycle's paths. Without it, cost.local_first decides the tiers.
+  // With `flown` (ctx.flown, from plan()) the ranking stops, answering no goal, once no node left
+  // in it can score above ctx.switch_factor times the flown goal's goal_score(): the main loop
+  // would keep that goal whatever the ranking answered, and the stale gains below that bar are
+  // not refreshed (the same flights, fewer gain evaluations). Only where the answer is the
+  // ranking's best node by score: no tiers, no local_first, no pockets.
   using TierFn = std::function<int(int64_t id)>;
   Goal select_goal(PlanContext& ctx, const ScoreFn& score, std::string* reason,
-                   int64_t* unreachable = nullptr, bool sweep = false, const TierFn* tier = nullptr);
+                   int64_t* unreachable = nullptr, bool sweep = false, const TierFn* tier = nullptr,
+                   const Goal* flown = nullptr);
   // One cycle (plan()) with goals ranked by `tier` first (nullptr: plan() itself).
   PlanOutcome plan_with(PlanContext& ctx, const TierFn* tier);
   // The paper's score (G + R_sem) / T_path (travel_cost.hpp).

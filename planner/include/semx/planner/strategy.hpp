@@ -26,6 +26,8 @@
 
 namespace semx::planner {
 
+struct Goal;
+
 struct PlanContext {
   const map::StateGrid* grid = nullptr;
   VehiclePose pose;
@@ -42,6 +44,11 @@ struct PlanContext {
   // the path is blocked, the controller gave up on it); otherwise it keeps the current goal unless
   // goal_score() says otherwise. FUEL decides on it whether to replan its tour.
   bool need_goal = false;
+  // When a goal is flown (need_goal false): that goal, and how many times its goal_score() another
+  // goal must score for the main loop to switch (loop.hysteresis; infinite for a held goal). A
+  // ranking may stop once nothing left in it can score that much: its answer would change nothing.
+  const Goal* flown = nullptr;
+  double switch_factor = 0.0;
   core::SplitMixRng* rng = nullptr;
   CycleCounters* counters = nullptr;
 };
