@@ -78,6 +78,7 @@ void FuelStrategy::reset() {
   rebuild_ = true;
   blacklist_.clear();
   strikes_.clear();
+  given_up_.clear();
   cycle_ = 0;
   target_ = Target();
   switch_ = false;
@@ -369,7 +370,8 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
                state_.at(s.cluster).views[static_cast<size_t>(s.views[0])].coverage >= f.major_coverage) ||
               promoted(ctx, *c));
     };
-    if (std::any_of(sites_.begin(), sites_.end(), major))
+    const bool any_major = std::any_of(sites_.begin(), sites_.end(), major);
+    if (any_major)
       sites_.erase(std::remove_if(sites_.begin(), sites_.end(), [&](const Site& s) { return !major(s); }),
                    sites_.end());
     if (waiting) *waiting = banned_only;
@@ -545,6 +547,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       continue;
     }
     Planned p;
+    p.minor_only = !any_major;
     p.cluster = first.cluster;
     p.site = layer_site[0];
     p.tour_cost = tour.cost;
@@ -626,12 +629,14 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   bool periodic = false;
   if (ctx.need_goal || !target_.valid) {
     why = ctx.need_goal ? "goal needed" : "no target";
-  } else if (remaining_fraction(ctx, target_) < 1.0 - f.covered_fraction) {
+  } else if (!target_.committed && remaining_fraction(ctx, target_) < 1.0 - f.covered_fraction) {
+    // (A committed target, given_up_, is flown until reached or its view is no longer free.)
     why = "target covered";
   } else if (!checker_.node_free(target_.goal.position)) {
     why = "target viewpoint no longer free";
-  } else if (f.replan_period > 0 && ctx.pose.utime - target_.planned_utime >=
-                                        static_cast<int64_t>(std::llround(f.replan_period * 1e6))) {
+  } else if (!target_.committed && f.replan_period > 0 &&
+             ctx.pose.utime - target_.planned_utime >=
+                 static_cast<int64_t>(std::llround(f.replan_period * 1e6))) {
     why = "periodic";
     periodic = true;
   }
@@ -687,6 +692,20 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     return finish();
   }
   toured_ = true;
+  {
+    const double near = config_.fuel.min_view_distance;
+    const auto place = [&](const Eigen::Vector3d& x) {
+      return std::find_if(given_up_.begin(), given_up_.end(),
+                          [&](const auto& g) { return (g.first - x).norm() < near; });
+    };
+    if (target_.valid && (vehicle_ - target_.goal.position).norm() >= near) {
+      auto it = place(target_.goal.position);
+      if (it == given_up_.end()) it = given_up_.insert(given_up_.end(), {target_.goal.position, 0});
+      ++it->second;
+    }
+    const auto it = place(p->goal.position);
+    target_.committed = p->minor_only && it != given_up_.end() && it->second >= kCommit;
+  }
   target_.valid = true;
   target_.cluster = p->cluster;
   target_.voxels = clusters_.find(p->cluster)->voxels;

@@ -659,6 +659,47 @@ TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
   EXPECT_TRUE(score.has_value()) << "a replan that chose the same view must not read as a switch";
 }
 
+// Once only small clusters are left, a place given up twice before it was reached is flown until
+// it is reached when chosen again: given up on the way again and again (each replan on the
+// approach chose another far place), small clusters were never reached and never skipped, and a
+// 280 m² world's process set flew 680 m between them to the time limit after its map had stopped
+// growing. Before that, and while clusters of FUEL's size are left, a covered target is replanned.
+TEST(Fuel, OnlySmallClustersLeftAPlaceGivenUpTwiceIsFlownUntilReached) {
+  // The replan reason of a flying cycle in which the target's cluster counts as covered (its
+  // voxels unobservable), after the same place was chosen `choices` times from afar.
+  const auto covered_after = [](int choices, bool only_small) {
+    PlanScene s("fuel");
+    if (only_small) s.config.fuel.major_cluster_voxels = 1000000000;
+    reveal_first_room(s);
+    FuelStrategy fuel(s.config);
+    const Eigen::Vector3d start(1.6, 2.4, 1.2);
+    Goal flown;
+    for (int i = 1; i <= choices; ++i) {
+      PlanContext ctx = s.context(start, 0.0, i);
+      ctx.need_goal = true;
+      const PlanOutcome o = fuel.plan(ctx);
+      EXPECT_TRUE(o.goal.valid) << o.reason;
+      if (i > 1) {
+        EXPECT_EQ(o.goal.position, flown.position) << "the same map: the same place";
+      }
+      flown = o.goal;
+    }
+    VoxelSet unobservable;
+    const FrontierClusters::Cluster* target = fuel.clusters().find(fuel.tour().front());
+    EXPECT_NE(target, nullptr);
+    if (target)
+      for (const VoxelKey& k : target->voxels) unobservable.insert(k);
+    PlanContext ctx = s.context(start, 0.0, choices + 1);
+    ctx.unobservable = &unobservable;
+    EXPECT_TRUE(fuel.plan(ctx).goal.valid);
+    EXPECT_TRUE(fuel.goal_score(ctx, flown).has_value());
+    return fuel.replan_reason();
+  };
+  EXPECT_EQ(covered_after(2, true).rfind("target covered", 0), 0u) << "given up once: replanned";
+  EXPECT_EQ(covered_after(3, true), "") << "given up twice: flown on";
+  EXPECT_EQ(covered_after(3, false).rfind("target covered", 0), 0u) << "large clusters left: replanned";
+}
+
 TEST(Fuel, DeclaresDoneOnAFullyKnownMap) {
   const SyntheticWorld w = SyntheticWorld::two_rooms();
   map::StateGrid g = w.full_map();
