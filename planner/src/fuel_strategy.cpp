@@ -33,6 +33,19 @@ constexpr double kSameView = 0.05;  // m and rad: a replanned view this near the
 
 const std::vector<Viewpoint> kNoViews;
 
+// Counts per place (strikes_, given_up_): places within `near` of each other are one.
+using PlaceCounts = std::vector<std::pair<Eigen::Vector3d, int>>;
+PlaceCounts::iterator place_at(PlaceCounts& places, const Eigen::Vector3d& x, double near) {
+  return std::find_if(places.begin(), places.end(),
+                      [&](const auto& p) { return (p.first - x).norm() < near; });
+}
+// The count of the place at x, a new place counting 0.
+int& count_at(PlaceCounts& places, const Eigen::Vector3d& x, double near) {
+  auto it = place_at(places, x, near);
+  if (it == places.end()) it = places.insert(places.end(), {x, 0});
+  return it->second;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> split_long_segments(const std::vector<Eigen::Vector3d>& waypoints, double max_length) {
@@ -692,20 +705,11 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
     return finish();
   }
   toured_ = true;
-  {
-    const double near = config_.fuel.min_view_distance;
-    const auto place = [&](const Eigen::Vector3d& x) {
-      return std::find_if(given_up_.begin(), given_up_.end(),
-                          [&](const auto& g) { return (g.first - x).norm() < near; });
-    };
-    if (target_.valid && (vehicle_ - target_.goal.position).norm() >= near) {
-      auto it = place(target_.goal.position);
-      if (it == given_up_.end()) it = given_up_.insert(given_up_.end(), {target_.goal.position, 0});
-      ++it->second;
-    }
-    const auto it = place(p->goal.position);
-    target_.committed = p->minor_only && it != given_up_.end() && it->second >= kCommit;
-  }
+  const double near = config_.fuel.min_view_distance;
+  if (target_.valid && (vehicle_ - target_.goal.position).norm() >= near)
+    ++count_at(given_up_, target_.goal.position, near);
+  const auto it = place_at(given_up_, p->goal.position, near);
+  target_.committed = p->minor_only && it != given_up_.end() && it->second >= kCommit;
   target_.valid = true;
   target_.cluster = p->cluster;
   target_.voxels = clusters_.find(p->cluster)->voxels;
@@ -729,10 +733,7 @@ void FuelStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {
   // ended: places skipped together are one.
   const double near = config_.fuel.min_view_distance;
   if ((vehicle_ - goal.position).norm() < near && !blacklisted(goal.position, cycle_)) {
-    auto it = std::find_if(strikes_.begin(), strikes_.end(),
-                           [&](const auto& s) { return (s.first - goal.position).norm() < near; });
-    if (it == strikes_.end()) it = strikes_.insert(strikes_.end(), {goal.position, 0});
-    if (++it->second >= kStrikes) until_cycle = kForGood;
+    if (++count_at(strikes_, goal.position, near) >= kStrikes) until_cycle = kForGood;
   }
   blacklist_.push_back({goal.position, until_cycle});
   if (target_.valid && (target_.goal.position - goal.position).norm() < 1e-9) target_.valid = false;

@@ -160,13 +160,12 @@ class FuelStrategy : public Strategy {
   std::vector<std::pair<Eigen::Vector3d, int>> strikes_;
   static constexpr int kStrikes = 2;
   // Places of targets given up before they were reached (another target chosen), with how many
-  // times: once only small clusters are left (none of FUEL's size), a place given up kCommit times
-  // is flown until reached (or its view is no longer free) when it is chosen again, whatever the
-  // replans say. Early on, giving places up is how the tour follows the map (committing to them
-  // there cost 5-14 s of Time_95 in env1-3). Given up on the way again and again (a
-  // replan on the approach picks another far place), small clusters were never reached, so never
-  // skipped either: a 280 m² world's process set flew 680 m between them after its map had
-  // stopped growing, to the time limit.
+  // times. Once only small clusters are left (none of FUEL's size), a place given up kCommit
+  // times is flown until reached (or until its view is no longer free) when it is chosen again,
+  // whatever the replans say: small clusters each given up on the way for another far one were
+  // never reached, so never skipped, and a 280 m² world's process set flew 680 m between them
+  // to the time limit after its map had stopped growing. Not earlier: giving places up is how
+  // the tour follows the map (committing there cost 5-14 s of Time_95 in env1-3).
   std::vector<std::pair<Eigen::Vector3d, int>> given_up_;
   static constexpr int kCommit = 2;
   int64_t cycle_ = 0;  // the cycle of the last plan
