@@ -228,7 +228,11 @@ StatusReport ExplorationPlanner::make_status(PlannerState state, const std::stri
     s.best_reward = best.reward;
     s.best_score = best.score;
   } else if (goal_.valid) {
+    // The cycle kept the goal flown (DEP's ranking found nothing above the switch bar): its values.
     s.goal = goal_.position;
+    s.best_gain = goal_.gain;
+    s.best_reward = goal_.reward;
+    s.best_score = goal_.score;
   }
   s.counters = c;
   s.charged_s = charged;
