@@ -785,6 +785,15 @@ TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   EXPECT_GT(stale, 0);
 }
 
+// Space mapped next to the corridor's roadmap (x 6-6.5 m), which makes most of its gains stale.
+void map_next_to_the_roadmap(DepFixture& f, DepStrategy& dep) {
+  fill_m(f.grid, {6.0, 0.0, 0.0}, {6.5, 4.0, 2.5}, VoxelState::kFree);
+  std::vector<map::VoxelChange> changes;
+  for (double y = 0.05; y < 4.0; y += 0.5)
+    changes.push_back({f.grid.keys().key({6.25, y, 1.0}), VoxelState::kFree});
+  dep.on_map_changes(changes);
+}
+
 // loop.flying_refresh: while a goal is flown, a cycle makes at most that many gain evaluations
 // and its goal is a node whose gain is fresh; a cycle that needs a goal evaluates what it needs.
 TEST(DepRoadmap, AFlyingCycleRefreshesAtMostItsBudgetOfGains) {
@@ -804,11 +813,7 @@ TEST(DepRoadmap, AFlyingCycleRefreshesAtMostItsBudgetOfGains) {
     PlanContext ctx = f.context({1, 2, 1.2});
     ctx.need_goal = true;
     EXPECT_TRUE(dep.plan(ctx).goal.valid);
-    // Space mapped next to the roadmap makes most of its gains stale.
-    fill_m(f.grid, {6.0, 0.0, 0.0}, {6.5, 4.0, 2.5}, VoxelState::kFree);
-    std::vector<map::VoxelChange> changes;
-    for (double y = 0.05; y < 4.0; y += 0.5) changes.push_back({f.grid.keys().key({6.25, y, 1.0}), VoxelState::kFree});
-    dep.on_map_changes(changes);
+    map_next_to_the_roadmap(f, dep);
     f.counters = CycleCounters();
     PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
     ctx2.need_goal = need_goal;
@@ -851,12 +856,7 @@ TEST(DepRoadmap, AFlyingCycleStopsRankingBelowTheSwitchBar) {
     ctx.need_goal = true;
     const Goal flown = dep.plan(ctx).goal;
     EXPECT_TRUE(flown.valid);
-    // Space mapped next to the roadmap makes most of its gains stale.
-    fill_m(f.grid, {6.0, 0.0, 0.0}, {6.5, 4.0, 2.5}, VoxelState::kFree);
-    std::vector<map::VoxelChange> changes;
-    for (double y = 0.05; y < 4.0; y += 0.5)
-      changes.push_back({f.grid.keys().key({6.25, y, 1.0}), VoxelState::kFree});
-    dep.on_map_changes(changes);
+    map_next_to_the_roadmap(f, dep);
     f.counters = CycleCounters();
     PlanContext ctx2 = f.context({1, 2, 1.2}, 0.0, 2);
     if (switch_factor) {
