@@ -16,6 +16,7 @@ constexpr uint8_t kHit = 2;     // a valid return of this frame ended in it
 // two axes most across the ray; see end_points_row).
 constexpr uint8_t kEndQuadrant0 = 4;
 constexpr uint8_t kAnyEnd = 0x3C;
+constexpr uint8_t kNearHit = 0x40;  // a valid return of this frame within hold_range ended in it
 
 // Ray parameters t in [0, 1] as 32.32 fixed point; "never" is far beyond any reachable sum.
 constexpr double kFixedOne = 4294967296.0;
@@ -292,6 +293,8 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
   const float camx = static_cast<float>(cam_local.x()), camy = static_cast<float>(cam_local.y()),
               camz = static_cast<float>(cam_local.z());
   int64_t kinds[5] = {0, 0, 0, 0, 0};
+  // z-depth, like the range limits: the hold range is a noise bound, and axial noise grows with z.
+  const float hold_z = static_cast<float>(map.params().hold_range);
 
   // ---- pass 1: per image row, the end point of every pixel (vectorised), then marks and walks
   // on the scratch grid ----
@@ -312,6 +315,7 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
       const uint8_t kind = row_kind_[j];
       if (kind == kInvalid || kind == kTooNear) continue;
       const bool hit = kind == kHitReturn;
+      const uint8_t near = hit && row_z_[j] <= hold_z ? kNearHit : 0;
       const int64_t idx = row_idx_[j];
       const uint8_t m = marks[idx];
       const uint8_t end_bit = static_cast<uint8_t>(kEndQuadrant0 << row_quadrant_[j]);
@@ -320,11 +324,11 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
                                                                      : false;
       if (covered) {
         // A ray of this frame was walked from here already: this one's way back is covered.
-        if (hit) marks[idx] = m | kHit | kWalked;
+        if (hit) marks[idx] = m | kHit | kWalked | near;
         continue;
       }
       // A max-range end voxel is not itself observed (OctoMap's maxrange convention).
-      marks[idx] = m | end_bit | (hit ? (kHit | kWalked) : 0);
+      marks[idx] = m | end_bit | (hit ? (kHit | kWalked | near) : 0);
       ++rep.rays_walked;
       const Walk w = make_walk(px[j], py[j], pz[j], idx, cam_local, stride);
       if (mode == IntegrationParams::Mode::kFast) {
@@ -375,7 +379,7 @@ IntegrationReport DepthIntegrator::integrate(const DepthFrame& f, OccupancyMap& 
           block_table_[(static_cast<size_t>(bk.z - bmin.z) * bny + (bk.y - bmin.y)) * bnx + (bk.x - bmin.x)];
       if (!block) block = &map.block(bk);
       map::VoxelState before, after;
-      map.apply(*block, key, map::local_index(key), (m & kHit) != 0, before, after);
+      map.apply(*block, key, map::local_index(key), (m & kHit) != 0, (m & kNearHit) != 0, before, after);
       if (before != after) {
         ++rep.voxels_changed;
         rep.changed_bounds.include(key);

@@ -2,6 +2,7 @@
 
 #include <octomap/OcTree.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -38,7 +39,8 @@ std::unique_ptr<octomap::OcTree> to_octree(const OccupancyMap& map, ExportReport
       const octomap::OcTreeKey ok(static_cast<uint16_t>(k.x + kOctoOffset),
                                   static_cast<uint16_t>(k.y + kOctoOffset),
                                   static_cast<uint16_t>(k.z + kOctoOffset));
-      tree->setNodeValue(ok, b->log_odds[i], /*lazy_eval=*/true);
+      // A held voxel (OccupancyMap::kHeld) is written as OctoMap's most certain one.
+      tree->setNodeValue(ok, std::min(b->log_odds[i], map.max_log_odds()), /*lazy_eval=*/true);
       ++rep.voxels;
     }
   }

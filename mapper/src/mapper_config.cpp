@@ -22,6 +22,7 @@ void load(runtime::ConfigMap& m, MapperConfig& c) {
   occ.get("clamp_min", c.occupancy.clamp_min, 0.001, 0.5);
   occ.get("clamp_max", c.occupancy.clamp_max, 0.5, 0.999);
   occ.get("threshold", c.occupancy.threshold, 0.001, 0.999);
+  occ.get("hold_range", c.occupancy.hold_range, 0.0, 100.0);
   occ.get("bounds_min", c.occupancy.bounds_min);
   occ.get("bounds_max", c.occupancy.bounds_max);
 

@@ -17,7 +17,8 @@ OccupancyMap::OccupancyMap(const OccupancyParams& params)
       l_miss_(logit(params.prob_miss)),
       l_min_(logit(params.clamp_min)),
       l_max_(logit(params.clamp_max)),
-      l_occ_(logit(params.threshold)) {
+      l_occ_(logit(params.threshold)),
+      hold_(params.hold_range > 0.0) {
   validate(params);
   if (!params.bounds_min.empty()) {
     bounded_ = true;
@@ -38,14 +39,19 @@ std::optional<float> OccupancyMap::log_odds(const map::VoxelKey& k) const {
   return b->log_odds[i];
 }
 
-map::VoxelState OccupancyMap::update(const map::VoxelKey& k, bool hit, bool* changed) {
+bool OccupancyMap::is_held(const map::VoxelKey& k) const {
+  const std::optional<float> l = log_odds(k);
+  return l && *l == kHeld;
+}
+
+map::VoxelState OccupancyMap::update(const map::VoxelKey& k, bool hit, bool* changed, bool near) {
   if (!in_bounds(k)) {
     if (changed) *changed = false;
     return grid_.state(k);
   }
   map::VoxelBlock& b = grid_.get_or_create_block(map::block_of(k));
   map::VoxelState before, after;
-  apply(b, k, map::local_index(k), hit, before, after);
+  apply(b, k, map::local_index(k), hit, near, before, after);
   if (changed) *changed = before != after;
   return after;
 }
@@ -57,7 +63,7 @@ void OccupancyMap::set_log_odds(const map::VoxelKey& k, float log_odds) {
   }
   map::VoxelBlock& b = grid_.get_or_create_block(map::block_of(k));
   const int i = map::local_index(k);
-  const float l = std::min(std::max(log_odds, l_min_), l_max_);
+  const float l = admit(log_odds);
   b.log_odds[i] = l;
   const map::VoxelState before = b.state[i];
   const map::VoxelState after = classify(l);
@@ -72,7 +78,7 @@ void OccupancyMap::set_block_log_odds(const map::VoxelKey& block_key, const floa
     map::VoxelState after = map::VoxelState::kUnknown;
     float l = 0.0f;
     if (!std::isnan(values[i])) {
-      l = std::min(std::max(values[i], l_min_), l_max_);
+      l = admit(values[i]);
       after = classify(l);
     }
     b.log_odds[i] = l;

@@ -1,10 +1,15 @@
 // Ray casting of depth frames into the occupancy map.
 #include <gtest/gtest.h>
 
+#include <octomap/OcTree.h>
+
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <memory>
 
 #include "mapper_test_util.hpp"
+#include "semx/mapper/map_export.hpp"
 
 namespace semx::mapper {
 namespace {
@@ -140,8 +145,16 @@ TEST(Integration, AReturnWinsOverAMaxRangeRayEndingInTheSameVoxel) {
   }
 }
 
+// SingleRay with OctoMap's rule everywhere (no hold range).
+struct OctomapRay : SingleRay {
+  OctomapRay() {
+    config.occupancy.hold_range = 0.0;
+    mapper = Mapper(config);
+  }
+};
+
 TEST(Integration, LogOddsAreClampedSoTheMapCanChangeItsMind) {
-  SingleRay r;
+  OctomapRay r;
   for (int i = 0; i < 40; ++i) r.shoot(1000);
   const OccupancyMap& map = r.mapper.map();
   EXPECT_FLOAT_EQ(*map.log_odds(map::VoxelKey{10, 0, 0}), std::log(0.971 / (1 - 0.971)));
@@ -153,6 +166,55 @@ TEST(Integration, LogOddsAreClampedSoTheMapCanChangeItsMind) {
   int frames = 0;
   while (map.state(map::VoxelKey{10, 0, 0}) == map::VoxelState::kOccupied && frames < 100) {
     r.shoot(2000);
+    ++frames;
+  }
+  EXPECT_EQ(frames, 9);
+}
+
+// The end of a thin door leaf: hit from close by until certain, then passed through by the rays of
+// another view. It stays occupied however long the other view lasts.
+TEST(Integration, AVoxelCertainFromCloseHitsIsHeldAgainstLaterMisses) {
+  SingleRay r;
+  ASSERT_EQ(r.config.occupancy.hold_range, 2.0);
+  const OccupancyMap& map = r.mapper.map();
+  const map::VoxelKey end{10, 0, 0};  // 1 m away
+  for (int i = 0; i < 4; ++i) r.shoot(1000);
+  EXPECT_LT(*map.log_odds(end), map.max_log_odds()) << "not certain yet: not held";
+  r.shoot(1000);
+  EXPECT_TRUE(map.is_held(end));
+  for (int i = 0; i < 100; ++i) r.shoot(2000);
+  EXPECT_EQ(map.state(end), map::VoxelState::kOccupied);
+  EXPECT_TRUE(map.is_held(end));
+  EXPECT_EQ(map.state(map::VoxelKey{20, 0, 0}), map::VoxelState::kOccupied) << "the new end is mapped";
+  EXPECT_EQ(map.state(map::VoxelKey{15, 0, 0}), map::VoxelState::kFree);
+
+  // A checkpoint keeps it held; the OctoMap export writes it as its most certain value.
+  const std::string path = test::temp_path("held.map");
+  r.mapper.save_checkpoint(path, 1);
+  Mapper back{r.config};
+  back.load_checkpoint(path);
+  EXPECT_TRUE(back.map().is_held(end));
+  back.integrate(DepthFrame::view(r.cam, looking_along_x({0.05, 0.05, 0.05}), r.depth));
+  EXPECT_EQ(back.map().state(end), map::VoxelState::kOccupied);
+  std::remove(path.c_str());
+  const std::unique_ptr<octomap::OcTree> tree = to_octree(map);
+  const octomap::OcTreeNode* node = tree->search(1.05, 0.05, 0.05);
+  ASSERT_NE(node, nullptr);
+  EXPECT_FLOAT_EQ(node->getLogOdds(), map.max_log_odds());
+}
+
+// Far hits do not hold (depth noise grows with range, and a doorway's edge seen from afar must
+// clear when seen up close): a voxel certain from 3 m away clears as OctoMap's would.
+TEST(Integration, AVoxelCertainOnlyFromFarHitsStillChangesItsMind) {
+  SingleRay r;
+  const OccupancyMap& map = r.mapper.map();
+  const map::VoxelKey end{30, 0, 0};  // 3 m away, beyond hold_range
+  for (int i = 0; i < 40; ++i) r.shoot(3000);
+  EXPECT_EQ(*map.log_odds(end), map.max_log_odds());
+  EXPECT_FALSE(map.is_held(end));
+  int frames = 0;
+  while (map.state(end) == map::VoxelState::kOccupied && frames < 100) {
+    r.shoot(4000);
     ++frames;
   }
   EXPECT_EQ(frames, 9);

@@ -2,7 +2,8 @@
 //
 // YAML layout (all keys optional; unknown keys are errors):
 //   resolution: 0.1
-//   occupancy:   { prob_hit, prob_miss, clamp_min, clamp_max, threshold, bounds_min, bounds_max }
+//   occupancy:   { prob_hit, prob_miss, clamp_min, clamp_max, threshold, hold_range, bounds_min,
+//                  bounds_max }
 //   integration: { min_range, max_range, pixel_step, frame_period_s, mode }
 //   esdf:        { enabled, window, max_distance, unknown_as_occupied }
 //   streaming:   { snapshot_period, stats_period, esdf_period, lockstep_delay }
@@ -24,6 +25,14 @@ struct OccupancyParams {
   double clamp_min = 0.1192;  // log-odds are clamped to [logit(clamp_min), logit(clamp_max)]
   double clamp_max = 0.971;   // so a voxel can change its mind after a few observations
   double threshold = 0.5;     // occupied iff P >= threshold (log-odds >= logit(threshold))
+  // m; 0 = OctoMap's rule everywhere. A voxel that reaches clamp_max on a hit from at most this
+  // range is held occupied: later misses no longer lower it. Why: a voxel only partly filled (the
+  // end of a 4 cm door leaf) is hit from one side and passed through from another, and OctoMap's
+  // clamp lets ten grazing frames clear what forty close ones saw; the body then flew into it
+  // (docs/mapper.md, "Thin obstacles"). Only close hits hold: far ones carry depth noise of a
+  // voxel or more, and a doorway's edge seen from afar must still clear when seen up close. It
+  // assumes a static world, as the worlds here are.
+  double hold_range = 2.0;
   // Optional world limits of the map, metres: voxels whose centre is outside are never updated
   // (rays still pass through). Both empty (default): the map grows to cover whatever is seen.
   std::vector<double> bounds_min;

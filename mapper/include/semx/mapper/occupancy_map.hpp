@@ -8,6 +8,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <limits>
 #include <optional>
 
 #include "semx/map/state_grid.hpp"
@@ -32,6 +34,10 @@ class OccupancyMap {
   float min_log_odds() const { return l_min_; }
   float max_log_odds() const { return l_max_; }
   float threshold_log_odds() const { return l_occ_; }
+  // The log-odds of a held voxel (OccupancyParams::hold_range): above every clamped value, so a
+  // checkpoint keeps it and classify() calls it occupied.
+  static constexpr float kHeld = std::numeric_limits<float>::infinity();
+  bool is_held(const map::VoxelKey& k) const;
   map::VoxelState classify(float log_odds) const {
     return log_odds >= l_occ_ ? map::VoxelState::kOccupied : map::VoxelState::kFree;
   }
@@ -50,8 +56,9 @@ class OccupancyMap {
 
   // One observation of one voxel (integration applies at most one per voxel per frame). Returns
   // the new state; *changed tells whether the state changed. Out-of-bounds voxels are ignored.
-  map::VoxelState update(const map::VoxelKey& k, bool hit, bool* changed = nullptr);
-  // Sets a voxel's log-odds (clamped into [min, max]); NaN makes the voxel unknown again.
+  // `near`: the hit came from within hold_range (ignored for misses and when hold_range is 0).
+  map::VoxelState update(const map::VoxelKey& k, bool hit, bool* changed = nullptr, bool near = false);
+  // Sets a voxel's log-odds (clamped into [min, max], kHeld kept); NaN makes the voxel unknown again.
   // For restoring checkpoints and building test scenes.
   void set_log_odds(const map::VoxelKey& k, float log_odds);
   // The same for a whole block: values[i] for local index i (NaN = unknown).
@@ -60,12 +67,13 @@ class OccupancyMap {
 
   // Batch path for the integrator: applies one observation to voxel i of block b and returns
   // the state before and after.
-  void apply(map::VoxelBlock& b, const map::VoxelKey& k, int i, bool hit, map::VoxelState& before,
+  void apply(map::VoxelBlock& b, const map::VoxelKey& k, int i, bool hit, bool near, map::VoxelState& before,
              map::VoxelState& after) {
     before = b.state[i];
+    // kHeld + l_miss stays kHeld, so a held voxel needs no test of its own.
     float l = b.log_odds[i] + (hit ? l_hit_ : l_miss_);
     if (l < l_min_) l = l_min_;
-    if (l > l_max_) l = l_max_;
+    if (l >= l_max_ && l != kHeld) l = hit && near && hold_ ? kHeld : l_max_;
     b.log_odds[i] = l;
     after = classify(l);
     if (after != before) {
@@ -88,9 +96,13 @@ class OccupancyMap {
   int64_t count_frontiers() const { return grid_.count_frontiers(); }
 
  private:
+  // A stored or restored value: kHeld stays held (only apply() makes it, so a checkpoint keeps
+  // it), anything else is clamped.
+  float admit(float l) const { return l == kHeld ? l : std::min(std::max(l, l_min_), l_max_); }
   OccupancyParams params_;
   map::StateGrid grid_;
   float l_hit_, l_miss_, l_min_, l_max_, l_occ_;
+  bool hold_;  // hold_range > 0
   bool bounded_ = false;
   map::KeyBox bounds_;
 };
