@@ -22,6 +22,7 @@ TEST(Config, DefaultsAreOctomapsAndThePapers) {
   EXPECT_DOUBLE_EQ(c.occupancy.clamp_min, 0.1192);
   EXPECT_DOUBLE_EQ(c.occupancy.clamp_max, 0.971);
   EXPECT_DOUBLE_EQ(c.occupancy.threshold, 0.5);
+  EXPECT_DOUBLE_EQ(c.occupancy.hold_range, 2.0);
   EXPECT_DOUBLE_EQ(c.integration.max_range, 5.0);
   EXPECT_EQ(c.integration.mode, IntegrationParams::Mode::kBundled);
   EXPECT_EQ(c.esdf.window, (std::vector<double>{10.0, 10.0, 3.0}));
@@ -32,7 +33,7 @@ TEST(Config, DefaultsAreOctomapsAndThePapers) {
 TEST(Config, ReadsEveryKey) {
   const MapperConfig c = load_yaml(R"(
 resolution: 0.05
-occupancy: {prob_hit: 0.8, prob_miss: 0.3, clamp_min: 0.12, clamp_max: 0.97, threshold: 0.6,
+occupancy: {prob_hit: 0.8, prob_miss: 0.3, clamp_min: 0.12, clamp_max: 0.97, threshold: 0.6, hold_range: 0,
             bounds_min: [-10, -10, 0], bounds_max: [10, 10, 3]}
 integration: {min_range: 0.3, max_range: 4.0, pixel_step: 2, mode: exact}
 esdf: {enabled: false, window: [8, 8, 2], max_distance: 2.0, unknown_as_occupied: false}
@@ -41,6 +42,7 @@ checkpoint: {path: /tmp/x.map, period: 60}
 )");
   EXPECT_DOUBLE_EQ(c.occupancy.resolution, 0.05);
   EXPECT_DOUBLE_EQ(c.occupancy.threshold, 0.6);
+  EXPECT_DOUBLE_EQ(c.occupancy.hold_range, 0.0);
   EXPECT_EQ(c.occupancy.bounds_max, (std::vector<double>{10, 10, 3}));
   EXPECT_EQ(c.integration.pixel_step, 2);
   EXPECT_EQ(c.integration.mode, IntegrationParams::Mode::kExact);
@@ -61,6 +63,7 @@ void expect_error(const std::string& yaml, const std::string& fragment) {
 TEST(Config, RejectsTyposAndNonsense) {
   expect_error("resolushun: 0.1", "resolushun");
   expect_error("occupancy: {prob_hit: 0.4}", "prob_hit");
+  expect_error("occupancy: {hold_range: -1}", "hold_range");
   expect_error("resolution: fast", "resolution");
   expect_error("occupancy: {clamp_min: 0.45, threshold: 0.4}", "clamp_min < threshold");
   expect_error("occupancy: {bounds_min: [0, 0, 0]}", "go together");
