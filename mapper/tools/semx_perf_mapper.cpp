@@ -157,6 +157,9 @@ int main(int argc, char** argv) {
   semx::runtime::PinholeCamera cam;  // 640x480, fx = fy = 320, 0.5-5 m: DESIGN.md §5
   sm::MapperConfig cfg;
   cfg.integration.pixel_step = pixel_step;
+  // The agreement is with OctoMap's update rule, so the mapper runs it too: a held voxel
+  // (docs/mapper.md, "Thin obstacles") is a deliberate departure, not a disagreement of the walk.
+  cfg.occupancy.hold_range = 0.0;
   cfg.integration.mode = mode == "exact" ? sm::IntegrationParams::Mode::kExact
                                          : (mode == "fast" ? sm::IntegrationParams::Mode::kFast
                                                            : sm::IntegrationParams::Mode::kBundled);

@@ -196,6 +196,11 @@ TEST(Integration, AVoxelCertainFromCloseHitsIsHeldAgainstLaterMisses) {
   EXPECT_TRUE(back.map().is_held(end));
   back.integrate(DepthFrame::view(r.cam, looking_along_x({0.05, 0.05, 0.05}), r.depth));
   EXPECT_EQ(back.map().state(end), map::VoxelState::kOccupied);
+  MapperConfig octomap_rule = r.config;
+  octomap_rule.occupancy.hold_range = 0.0;
+  Mapper plain{octomap_rule};
+  plain.load_checkpoint(path);
+  EXPECT_EQ(*plain.map().log_odds(end), plain.map().max_log_odds()) << "no holding: clamped";
   std::remove(path.c_str());
   const std::unique_ptr<octomap::OcTree> tree = to_octree(map);
   const octomap::OcTreeNode* node = tree->search(1.05, 0.05, 0.05);

@@ -96,9 +96,9 @@ class OccupancyMap {
   int64_t count_frontiers() const { return grid_.count_frontiers(); }
 
  private:
-  // A stored or restored value: kHeld stays held (only apply() makes it, so a checkpoint keeps
-  // it), anything else is clamped.
-  float admit(float l) const { return l == kHeld ? l : std::min(std::max(l, l_min_), l_max_); }
+  // A stored or restored value: kHeld stays held while holding is on (only apply() makes it, so a
+  // checkpoint keeps it), anything else is clamped.
+  float admit(float l) const { return l == kHeld && hold_ ? l : std::min(std::max(l, l_min_), l_max_); }
   OccupancyParams params_;
   map::StateGrid grid_;
   float l_hit_, l_miss_, l_min_, l_max_, l_occ_;
