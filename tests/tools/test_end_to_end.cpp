@@ -23,6 +23,11 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kTimeLimit = 20.0;  // simulated s: the first views and the first flights
+// The killed-processes run and its calm twin: the planner, killed at 12 s, comes back with an empty
+// roadmap, so the two flights part there. At 20 s env1's coverage still climbs a point a second
+// and chance alone put them 3 points apart (after the mapper's held voxels changed which goals came
+// first); by 30 s both have looked into the same rooms.
+constexpr double kKilledTimeLimit = 30.0;
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
@@ -48,16 +53,17 @@ double progress_time(const std::string& console) {
 // The demo set on env1 for kTimeLimit simulated s; each of `kills` (process name, simulated s) is
 // killed with SIGKILL once the run's simulated time reaches it.
 DemoRun run_demo(const std::string& name, int port_offset,
-                 const std::vector<std::pair<std::string, double>>& kills = {}) {
+                 const std::vector<std::pair<std::string, double>>& kills = {},
+                 double time_limit = kTimeLimit) {
   DemoRun r;
   r.dir = ::testing::TempDir() + "/semx_e2e_" + std::to_string(getpid()) + "_" + name;
   fs::remove_all(r.dir);
   const std::string out = r.dir + ".out";
   const std::string url = semx::runtime::udpm_url_for_port(test_port(port_offset));
-  Process launcher({bin("semx-launch"), "demo", "--lcm-url", url, "--no-color", "--arg", "out=" + r.dir,
-                    "--arg", "time_limit=" + std::to_string(kTimeLimit), "--arg",
-                    kills.empty() ? "progress=5" : "progress=1"},
-                   out);
+  Process launcher(
+      {bin("semx-launch"), "demo", "--lcm-url", url, "--no-color", "--arg", "out=" + r.dir, "--arg",
+       "time_limit=" + std::to_string(time_limit), "--arg", kills.empty() ? "progress=5" : "progress=1"},
+      out);
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(400);
   size_t next = 0;
   while (launcher.alive() && std::chrono::steady_clock::now() < end) {
@@ -149,12 +155,12 @@ TEST(EndToEnd, DemoSetExploresAndWritesTheRunFolder) {
 // the run completes with coverage within 2 points of the undisturbed run, and metrics.json is
 // written and says who restarted when.
 TEST(EndToEnd, EveryProcessKilledComesBackAndTheRunCompletes) {
-  const DemoRun calm = run_demo("calm", 5);
+  const DemoRun calm = run_demo("calm", 5, {}, kKilledTimeLimit);
   ASSERT_EQ(calm.exit_code, 0) << calm.console;
   const std::vector<std::pair<std::string, double>> kills = {
       {"mapper", 3}, {"simulator", 6}, {"evaluator", 9}, {"planner", 12},
       {"controller", 14}, {"semantics", 16}, {"logger", 17}};
-  const DemoRun hit = run_demo("hit", 6, kills);
+  const DemoRun hit = run_demo("hit", 6, kills, kKilledTimeLimit);
   ASSERT_EQ(hit.exit_code, 0) << hit.console;
   for (const auto& [name, at] : kills) {
     EXPECT_NE(hit.console.find("] " + name + ": restarted (pid"), std::string::npos) << name << "\n" << hit.console;
@@ -172,7 +178,7 @@ TEST(EndToEnd, EveryProcessKilledComesBackAndTheRunCompletes) {
   EXPECT_EQ(b["collisions"].as<int>(), 0);
   // The coverage series has no hole where the evaluator was down, and the log reads to its end.
   const auto curve = coverage_curve(hit.dir + "/coverage.csv");
-  ASSERT_GE(curve.size(), static_cast<size_t>(kTimeLimit));
+  ASSERT_GE(curve.size(), static_cast<size_t>(kKilledTimeLimit));
   for (size_t i = 1; i < curve.size(); ++i) EXPECT_LE(curve[i].first - curve[i - 1].first, 1.0 + 1e-9) << i;
   for (const char* f : {"map.png", "map.bt", "run.lcmlog", "coverage.png"})
     EXPECT_GT(fs::file_size(fs::path(hit.dir) / f), 0u) << f;
