@@ -179,7 +179,9 @@ TEST(EndToEnd, EveryProcessKilledComesBackAndTheRunCompletes) {
   // The coverage series has no hole where the evaluator was down, and the log reads to its end.
   const auto curve = coverage_curve(hit.dir + "/coverage.csv");
   ASSERT_GE(curve.size(), static_cast<size_t>(kKilledTimeLimit));
-  for (size_t i = 1; i < curve.size(); ++i) EXPECT_LE(curve[i].first - curve[i - 1].first, 1.0 + 1e-9) << i;
+  // A hole is a missing 1 s sample. A restarted evaluator takes its first sample at the first tick
+  // it hears, which can come a few ticks after the grid time (CI: 8.0, then 9.05 s).
+  for (size_t i = 1; i < curve.size(); ++i) EXPECT_LT(curve[i].first - curve[i - 1].first, 1.5) << i;
   for (const char* f : {"map.png", "map.bt", "run.lcmlog", "coverage.png"})
     EXPECT_GT(fs::file_size(fs::path(hit.dir) / f), 0u) << f;
 }
