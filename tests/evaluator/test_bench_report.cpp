@@ -194,6 +194,65 @@ TEST(BenchReport, DisturbedRunsAreListedUnderTheTablesNotInThem) {
   EXPECT_NE(bench_csv(runs).find(",true\n"), std::string::npos) << "the CSV keeps every run, marked";
 }
 
+// Replaces `from` with `to` in a run folder's metrics.json (write_run's fixed fields).
+void edit_run(const std::string& root, const std::string& run, const std::string& from,
+              const std::string& to) {
+  const fs::path file = fs::path(root) / run / "metrics.json";
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << file;
+  text.replace(at, from.size(), to);
+  std::ofstream(file) << text;
+}
+
+// Two benches of the same runs: each run of A paired with B's of the same world, planner and
+// seed; the paired differences with their intervals per planner, over all and per set of worlds;
+// collisions, DONE and the least coverage of each side; the runs without a partner listed.
+TEST(BenchReport, AgainstABaselineBenchPairsEachRunWithItsTwin) {
+  const std::string a = test::temp_dir("bench_against_a"), b = test::temp_dir("bench_against_b");
+  // dep: env1 seeds 1 and 2 (10 against 20 s, 30 against 20 s), a generated world (10 against 10).
+  write_run(a, "env1", "dep", 1, 100, 10, 5);
+  write_run(b, "env1", "dep", 1, 100, 20, 5);
+  write_run(a, "env1", "dep", 2, 100, 30, 5);
+  write_run(b, "env1", "dep", 2, 100, 20, 5);
+  write_run(a, "generated-s1-a50-r1", "dep", 1, 100, 10, 5);
+  write_run(b, "generated-s1-a50-r1", "dep", 1, 100, 10, 5);
+  // fuel: B's run touched an obstacle and hit the time limit at lower coverage.
+  write_run(a, "env1", "fuel", 1, 100, 8, 5);
+  write_run(b, "env1", "fuel", 1, 200, 10, 5);
+  edit_run(b, "env1-fuel-s45-seed1", "\"collisions\": 0", "\"collisions\": 1");
+  edit_run(b, "env1-fuel-s45-seed1", "planner_done", "time_limit");
+  edit_run(b, "env1-fuel-s45-seed1", "\"coverage_pct\": 95", "\"coverage_pct\": 90.5");
+  // Without a partner.
+  write_run(a, "env2", "dep", 1, 100, 10, 5);
+  write_run(b, "env3", "dep", 1, 100, 10, 5);
+
+  const std::string md = bench_against_markdown(load_bench_runs(a), load_bench_runs(b));
+  EXPECT_NE(md.find("| dep | 3 | 0 / 0 | 3 / 3 | 95.00 / 95.00 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| fuel | 1 | 0 / 1 | 1 / 0 | 95.00 / 90.50 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| all planners | 4 | 0 / 1 | 4 / 3 | 95.00 / 90.50 |"), std::string::npos) << md;
+  // dep over both worlds: -10, +10 and 0 s; -50, +50 and 0 %; sd 10 s and 50 %, t(2) 4.303.
+  EXPECT_NE(md.find("| all (2 worlds) | dep | Time_r | 3 | 1 / 1 / 1 | +0.00 | [-24.84, 24.84] | +0.0 | "
+                    "[-124.2, 124.2] |"),
+            std::string::npos)
+      << md;
+  // Time_f is always there: fuel's 100 against 200 s.
+  EXPECT_NE(md.find("| all (2 worlds) | fuel | Time_f | 1 | 1 / 0 / 0 | -100.00 | – | -50.0 | – |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| generated (1 worlds) | dep | Time_r | 1 | 0 / 1 / 0 | +0.00 | – |"), std::string::npos)
+      << md;
+  // env1 alone: dep's two seeds (sd 14.14 s, t(1) 12.706), and all planners pooled there.
+  EXPECT_NE(md.find("| env1 | dep | Time_r | 2 | 1 / 0 / 1 | +0.00 | [-127.06, 127.06] |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| env1 | all planners | Time_r | 3 | 2 / 0 / 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env1 | fuel | 1 | 8.0 / 10.0 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("- only in A: env2, dep, seed 1"), std::string::npos) << md;
+  EXPECT_NE(md.find("- only in B: env3, dep, seed 1"), std::string::npos) << md;
+  EXPECT_EQ(md.find("| env2 |"), std::string::npos) << md;
+}
+
 TEST(BenchReport, ABadRunFolderIsAnErrorNamingTheFile) {
   const std::string root = test::temp_dir("bench_report_bad");
   write_run(root, "env1", "dep", 1, 100, 10, 20);

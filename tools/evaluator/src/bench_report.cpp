@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "semx/evaluator/coverage_plot.hpp"
 #include "semx/evaluator/montage.hpp"
@@ -647,6 +649,139 @@ std::vector<std::string> write_bench_montages(const std::vector<BenchRun>& all, 
     written.push_back(file);
   }
   return written;
+}
+
+std::string bench_against_markdown(const std::vector<BenchRun>& a_all, const std::vector<BenchRun>& b_all,
+                                   const BenchReportOptions& o) {
+  const std::vector<BenchRun> a = tabled_only(a_all), b = tabled_only(b_all);
+  using Key = std::tuple<std::string, std::string, int64_t>;  // world, planner, seed
+  auto key_of = [](const BenchRun& r) { return Key{r.world, r.planner, r.seed}; };
+  std::map<Key, const BenchRun*> in_b;
+  for (const auto& r : b)
+    if (r.samples == o.comparison_samples) in_b[key_of(r)] = &r;
+  struct Pair {
+    const BenchRun *a, *b;
+  };
+  std::vector<Pair> pairs;
+  std::vector<const BenchRun*> only_a;
+  std::set<Key> paired;
+  for (const auto& r : a) {
+    if (r.samples != o.comparison_samples) continue;
+    const auto it = in_b.find(key_of(r));
+    if (it == in_b.end()) {
+      only_a.push_back(&r);
+      continue;
+    }
+    pairs.push_back({&r, it->second});
+    paired.insert(it->first);
+  }
+  std::sort(pairs.begin(), pairs.end(), [&](const Pair& x, const Pair& y) {
+    if (x.a->world != y.a->world) return x.a->world < y.a->world;
+    if (x.a->planner != y.a->planner) return planner_rank(x.a->planner) < planner_rank(y.a->planner);
+    return x.a->seed < y.a->seed;
+  });
+  std::vector<std::string> planners;
+  for (const auto& p : pairs)
+    if (std::find(planners.begin(), planners.end(), p.a->planner) == planners.end())
+      planners.push_back(p.a->planner);
+  std::stable_sort(planners.begin(), planners.end(), [](const std::string& x, const std::string& y) {
+    return planner_rank(x) < planner_rank(y);
+  });
+  const std::string all_planners = "all planners";
+  auto in_group = [&](const Pair& p, const std::string& planner) {
+    return planner == all_planners || p.a->planner == planner;
+  };
+  std::vector<std::string> groups = planners;
+  if (planners.size() > 1) groups.push_back(all_planners);
+
+  std::ostringstream md;
+  md << "### A against B, run by run (A: this bench, B: the baseline bench)\n\n"
+     << "Each run of A paired with B's run of the same world, planner and seed at " << o.comparison_samples
+     << " samples (valid, undisturbed runs only). DONE: the planner ended the run.\n\n"
+     << "| planner | pairs | collisions A / B | DONE A / B | least coverage A / B (%) "
+        "|\n|---|---|---|---|---|\n";
+  for (const auto& g : groups) {
+    int n = 0, done_a = 0, done_b = 0;
+    int64_t col_a = 0, col_b = 0;
+    double least_a = 1e9, least_b = 1e9;
+    for (const auto& p : pairs) {
+      if (!in_group(p, g)) continue;
+      ++n;
+      col_a += p.a->collisions;
+      col_b += p.b->collisions;
+      done_a += p.a->termination == "planner_done";
+      done_b += p.b->termination == "planner_done";
+      least_a = std::min(least_a, p.a->coverage_pct);
+      least_b = std::min(least_b, p.b->coverage_pct);
+    }
+    md << "| " << g << " | " << n << " | " << col_a << " / " << col_b << " | " << done_a << " / " << done_b
+       << " | " << fmt(least_a, 2) << " / " << fmt(least_b, 2) << " |\n";
+  }
+
+  using Field = std::function<std::optional<double>(const BenchRun&)>;
+  const std::vector<std::pair<const char*, Field>> times = {
+      {"Time_r", [](const BenchRun& r) { return r.time_r_s; }},
+      {"Time_95", [](const BenchRun& r) { return r.time_95_s; }},
+      {"Time_o", [](const BenchRun& r) { return r.time_o_s; }},
+      {"Time_f", [](const BenchRun& r) { return std::optional<double>(r.time_f_s); }}};
+  // The sets: every world, the generated ones pooled, and each other world.
+  std::vector<std::pair<std::string, std::function<bool(const std::string&)>>> sets;
+  std::set<std::string> generated, others;
+  for (const auto& p : pairs) (is_generated(p.a->world) ? generated : others).insert(p.a->world);
+  sets.emplace_back("all (" + std::to_string(generated.size() + others.size()) + " worlds)",
+                    [](const std::string&) { return true; });
+  if (!generated.empty() && !others.empty())
+    sets.emplace_back(std::string(kGeneratedPrefix) + " (" + std::to_string(generated.size()) + " worlds)",
+                      [](const std::string& w) { return is_generated(w); });
+  for (const auto& w : others) sets.emplace_back(w, [w](const std::string& x) { return x == w; });
+  md << "\n### A against B, paired\n\n"
+     << "Over the pairs where both runs reached the time's threshold: how many A reached it sooner / at the "
+        "same time (±0.05 s) / later, the mean of A's time minus B's, and the mean relative difference "
+        "(A / B − 1), each with its 95 % interval (Student's t over the pairs).\n\n"
+     << "| worlds | planner | time | pairs | sooner / same / later | mean difference (s) | 95 % interval (s) "
+        "| "
+        "mean relative difference (%) | 95 % interval (%) |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [set_name, in_set] : sets) {
+    for (const auto& g : groups) {
+      for (const auto& [name, field] : times) {
+        std::vector<std::pair<double, double>> v;
+        for (const auto& p : pairs) {
+          if (!in_group(p, g) || !in_set(p.a->world)) continue;
+          const std::optional<double> x = field(*p.a), y = field(*p.b);
+          if (x && y) v.emplace_back(*x, *y);
+        }
+        md << "| " << set_name << " | " << g << " | " << name << " | " << paired_cells(v) << "\n";
+      }
+    }
+  }
+
+  auto opt = [](std::optional<double> v) { return v ? fmt(*v, 1) : std::string("–"); };
+  md << "\n### Every pair (A / B)\n\n"
+     << "| Env. | Algorithm | seed | Time_r (s) | Time_95 (s) | Time_o (s) | Time_f (s) | Coverage (%) | "
+        "collisions | termination |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& p : pairs) {
+    md << "| " << p.a->world << " | " << p.a->planner << " | " << p.a->seed << " | " << opt(p.a->time_r_s)
+       << " / " << opt(p.b->time_r_s) << " | " << opt(p.a->time_95_s) << " / " << opt(p.b->time_95_s) << " | "
+       << opt(p.a->time_o_s) << " / " << opt(p.b->time_o_s) << " | " << fmt(p.a->time_f_s, 1) << " / "
+       << fmt(p.b->time_f_s, 1) << " | " << fmt(p.a->coverage_pct, 2) << " / " << fmt(p.b->coverage_pct, 2)
+       << " | " << p.a->collisions << " / " << p.b->collisions << " | " << p.a->termination << " / "
+       << p.b->termination << " |\n";
+  }
+  std::string unpaired;
+  for (const auto* r : only_a)
+    unpaired += "- only in A: " + r->world + ", " + r->planner + ", seed " + std::to_string(r->seed) + " (" +
+                r->dir + ")\n";
+  for (const auto& [k, r] : in_b)
+    if (!paired.count(k))
+      unpaired += "- only in B: " + r->world + ", " + r->planner + ", seed " + std::to_string(r->seed) +
+                  " (" + r->dir + ")\n";
+  const size_t left_out = (a_all.size() - a.size()) + (b_all.size() - b.size());
+  if (left_out > 0)
+    unpaired +=
+        "- " + std::to_string(left_out) + " runs not valid or disturbed (see each bench's tables.md)\n";
+  if (!unpaired.empty()) md << "\n### Runs without a partner\n\n" << unpaired;
+  return md.str();
 }
 
 }  // namespace semx::evaluator

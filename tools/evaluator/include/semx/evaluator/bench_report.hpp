@@ -65,6 +65,15 @@ inline constexpr const char* kGeneratedPrefix = "generated";
 // the known-map oracle's (where the bench ran `oracle`), and semantic-dep's margins over each
 // baseline (Time_f, Time_r, Time_o, Distance, in %), each world in the order the runs name them.
 std::string bench_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& options = {});
+// Two benches of the same runs, e.g. a change against main or a config against its default:
+// `runs` (A) against `baseline` (B), each run of A paired with B's run of the same world,
+// planner, seed and density (valid, undisturbed runs at the comparison density only). Per
+// planner and over all planners: collisions, runs ended DONE and the least coverage in A and B;
+// Time_r, Time_95, Time_o and Time_f paired (as the seed-by-seed table: sooner / same / later,
+// mean difference and relative difference with 95 % intervals) over every world, over the
+// generated worlds and per other world; then every pair; then the runs without a partner.
+std::string bench_against_markdown(const std::vector<BenchRun>& runs, const std::vector<BenchRun>& baseline,
+                                   const BenchReportOptions& options = {});
 // One row per run (the columns of metrics.csv plus the folder).
 std::string bench_csv(const std::vector<BenchRun>& runs);
 // Coverage curves of several runs ((t s, %), t increasing) at 0, step_s, ... up to t_max_s:
