@@ -170,12 +170,13 @@ TEST(BenchPlan, FlagsApplyInOrder) {
   EXPECT_EQ(parse_bench_args({"--time-limits", "env1=5", "--time-limit", "7"}).time_limits, "*=7");
   EXPECT_EQ(parse_bench_args({"--time-limit", "7", "--time-limits", "env1=5"}).time_limits, "env1=5");
   EXPECT_EQ(parse_bench_args({"--sweep", ""}).sweep, "");
-  const BenchOptions o = parse_bench_args(
-      {"--logs", "--dry-run", "--jobs", "2", "--out", "d", "--arg", "a=1", "--arg", "b=x=y"});
+  const BenchOptions o = parse_bench_args({"--logs", "--dry-run", "--jobs", "2", "--out", "d", "--arg", "a=1",
+                                           "--arg", "b=x=y", "--against", "base"});
   EXPECT_TRUE(o.keep_logs);
   EXPECT_TRUE(o.dry_run);
   EXPECT_EQ(job_count(o), 2);
   EXPECT_EQ(o.out, "d");
+  EXPECT_EQ(o.against, "base");
   EXPECT_EQ(o.launch_args, (std::vector<std::string>{"a=1", "b=x=y"}));
   // --help ends the parsing, but only what comes after it goes unread.
   EXPECT_TRUE(parse_bench_args({"--seeds", "x", "--help", "--bogus"}).help);
@@ -195,6 +196,9 @@ TEST(BenchPlan, FlagErrorsNameTheFlag) {
   EXPECT_EQ(error_of({"--time-limits"}), "--time-limits needs WORLD=S,...");
   EXPECT_EQ(error_of({"--time-limit"}), "--time-limit needs seconds");
   EXPECT_EQ(error_of({"--out", ""}), "--out needs a directory");
+  EXPECT_EQ(error_of({"--against"}), "--against needs a bench folder");
+  EXPECT_EQ(error_of({"--against", "/nonexistent/bench"}),
+            "--against '/nonexistent/bench': not a directory (a bench's --out folder)");
   EXPECT_EQ(error_of({"--jobs"}), "--jobs needs a number");
   EXPECT_EQ(error_of({"--arg"}), "--arg needs KEY=VALUE");
   EXPECT_EQ(error_of({"--arg", "world=env2"}),

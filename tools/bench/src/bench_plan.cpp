@@ -40,6 +40,11 @@ bool is_regular_file(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+bool is_directory(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
 // The value of the last ",KEY=S," in `text` (",LIST,") whose S is digits and dots: what the bash
 // bench's `sed -n 's/.*,KEY=\([0-9.]*\),.*/\1/p'` printed (its leading .* is greedy, so the last).
 // KEY is matched as text, where sed read it as a pattern; world names are plain.
@@ -120,6 +125,8 @@ BenchOptions parse_bench_args(const std::vector<std::string>& args) {
       o.time_limits = "*=" + value("--time-limit needs seconds");
     } else if (a == "--out") {
       o.out = value("--out needs a directory");
+    } else if (a == "--against") {
+      o.against = value("--against needs a bench folder");
     } else if (a == "--logs") {
       o.keep_logs = true;
     } else if (a == "--arg") {
@@ -155,6 +162,9 @@ BenchOptions parse_bench_args(const std::vector<std::string>& args) {
 
 void validate_bench_options(const BenchOptions& o) {
   if (!positive_integer(o.seeds)) throw ArgError("--seeds '" + o.seeds + "': expected a positive integer");
+  if (!o.against.empty() && !is_directory(o.against)) {
+    throw ArgError("--against '" + o.against + "': not a directory (a bench's --out folder)");
+  }
   if (!positive_integer(o.samples)) {
     throw ArgError("--samples '" + o.samples + "': expected a positive integer");
   }
@@ -307,7 +317,7 @@ std::string dry_run_text(const std::vector<BenchRun>& runs) {
 std::string bench_help() {
   return R"(usage: ./semx bench [--worlds LIST] [--planners LIST] [--seeds N] [--sweep LIST] [--samples N]
                     [--time-limits WORLD=S,...|--time-limit S] [--out DIR] [--logs] [--jobs N]
-                    [--arg KEY=VALUE]... [--quick] [--dry-run]
+                    [--arg KEY=VALUE]... [--against BASE] [--quick] [--dry-run]
 
 The paper's experiment, in LOCKSTEP (deterministic per seed): for every world and seeds 1..N,
 (a) the sampling-density sweep of Table II for semantic-dep (--sweep LIST for every world; the
@@ -331,7 +341,9 @@ depend on it, only the wall times do): slot k talks on LCM_DEFAULT_URL (default
 udpm://239.255.76.67:7667?ttl=0) with its port + k, or on --base-port P + k; recv_buf_size=4194304
 is added when the URL has none. --arg KEY=VALUE goes to every run's process set
 (tools/launch/demo.yaml), e.g. --arg semantics_config=FILE or --arg planner_config=FILE for an
-ablation. --quick: env1, one seed, no sweep, 120 s. --dry-run prints the runs in the order they
+ablation. --against BASE (another bench's --out folder, e.g. the same command without the
+ablation or on main): the report also writes DIR/against.md, each run paired with BASE's of the
+same world, planner and seed, with 95 % intervals. --quick: env1, one seed, no sweep, 120 s. --dry-run prints the runs in the order they
 would start (the worlds with the longest time limit first) and their time limits, and runs nothing.
 )";
 }

@@ -97,7 +97,12 @@ int main(int argc, char** argv) {
               << static_cast<long long>(runtime::monotonic_s() - t0) << " s" << std::endl;
     std::fflush(stdout);
     const std::string report = runtime::executable_dir() + "/semx-bench-report";
-    execl(report.c_str(), report.c_str(), out.c_str(), static_cast<char*>(nullptr));
+    if (o.against.empty()) {
+      execl(report.c_str(), report.c_str(), out.c_str(), static_cast<char*>(nullptr));
+    } else {
+      execl(report.c_str(), report.c_str(), out.c_str(), "--against", o.against.c_str(),
+            static_cast<char*>(nullptr));
+    }
     throw std::runtime_error("cannot run '" + report + "': " + std::strerror(errno));
   });
 }

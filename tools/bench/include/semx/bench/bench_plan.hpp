@@ -22,6 +22,7 @@ struct BenchOptions {
   std::string samples = "45";   // the density of the planner comparison
   std::string time_limits = "env1=300,env2=600,env3=900";  // NAME=S,...; "*" matches every world
   std::string out;                                         // empty: runs/bench-DATE
+  std::string against;  // another bench's folder: the report pairs the runs with its (against.md)
   bool keep_logs = false;
   std::string clock = "lockstep";
   std::string jobs = "1";
