@@ -555,7 +555,17 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     }
     ctx.counters->connect_ms += pw.ms();
     if (!found) {
-      blacklist_.push_back({goal_view.position, ctx.cycle + config_.loop.blacklist_cycles});
+      // The field's lattice is lenient (grid_search.hpp) where A* keeps the passage clearance,
+      // so a view can be reached on one and never on the other. While recovering nothing else is
+      // flown and the map stands still, so its search fails again when the skip ends: env3 with
+      // noise (fuel, seed 2, mapper without held voxels) skipped and freed three clusters' views
+      // every 21 cycles from 198 s to the 900 s limit, each skip holding DONE back. A view whose
+      // search failed while recovering is a strike at its place, as a visit is (reject_goal).
+      int64_t until = ctx.cycle + config_.loop.blacklist_cycles;
+      if (ctx.recovering &&
+          ++count_at(strikes_, goal_view.position, config_.fuel.min_view_distance) >= kStrikes)
+        until = kForGood;
+      blacklist_.push_back({goal_view.position, until});
       *reason = "no path to the tour's next viewpoint";
       continue;
     }

@@ -154,9 +154,10 @@ class FuelStrategy : public Strategy {
     int64_t until_cycle;
   };
   std::vector<Banned> blacklist_;
-  // Places of goals the vehicle reached, with how many times after their skip had ended: the
-  // kStrikes-th time a place is banned for good (its cluster's voxels cannot be seen from there),
-  // and a ban for good does not hold DONE back.
+  // Places of goals the vehicle reached, with how many times after their skip had ended, and of
+  // views no path was found to while recovering: the kStrikes-th time a place is banned for good
+  // (its cluster's voxels cannot be seen from there, or it cannot be reached), and a ban for good
+  // does not hold DONE back.
   std::vector<std::pair<Eigen::Vector3d, int>> strikes_;
   static constexpr int kStrikes = 2;
   // Places of targets given up before they were reached (another target chosen), with how many
