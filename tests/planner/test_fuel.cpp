@@ -824,17 +824,6 @@ TEST(Fuel, AViewNoPathReachesIsSkippedForGoodAtItsSecondFailureWhileRecovering) 
     ctx.recovering = recovering;
     return fuel.plan(ctx);
   };
-  // Plans until the turns in place at the start are over (no tour goal was ever found): the
-  // first outcome without a goal.
-  const auto after_the_turns = [&](FuelStrategy& fuel, PlanScene& s, bool recovering) {
-    PlanOutcome o;
-    for (int64_t cycle = 1; cycle < 10; ++cycle) {
-      o = plan_at(fuel, s, cycle, recovering);
-      if (!o.goal.valid) break;
-      EXPECT_EQ(o.reason.rfind("turning in place at the start", 0), 0u) << o.reason;
-    }
-    return o;
-  };
   {
     PlanScene s("fuel");
     FuelStrategy fuel(s.config);
