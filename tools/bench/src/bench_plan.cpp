@@ -343,7 +343,8 @@ is added when the URL has none. --arg KEY=VALUE goes to every run's process set
 (tools/launch/demo.yaml), e.g. --arg semantics_config=FILE or --arg planner_config=FILE for an
 ablation. --against BASE (another bench's --out folder, e.g. the same command without the
 ablation or on main): the report also writes DIR/against.md, each run paired with BASE's of the
-same world, planner and seed, with 95 % intervals. --quick: env1, one seed, no sweep, 120 s. --dry-run prints the runs in the order they
+same world, planner and seed, with 95 % intervals. --quick: env1, one seed, no sweep, 120 s.
+--dry-run prints the runs in the order they
 would start (the worlds with the longest time limit first) and their time limits, and runs nothing.
 )";
 }
