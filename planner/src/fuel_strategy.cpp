@@ -23,6 +23,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int64_t kMaxFieldCells = 4000000;
 // Voxels the A* to the goal may settle: an apartment's free space at 0.1 m is ~10^6.
 constexpr int64_t kMaxPathVoxels = 600000;
+// ... and the A* that leaves the coarse path's corridor when the search along it failed. Such a
+// failure is the field's lenient cells passing a gap A* cannot, so the wider search failed too,
+// after settling its whole budget: a 0.7 s planning cycle of semantic-fuel in the 600 m² world.
+// A detour around a corridor's obstacle is local: a cube of 4.6 m at 0.1 m.
+constexpr int64_t kMaxDetourVoxels = 100000;
 // Goals tried per plan when the chosen one has no path.
 constexpr int kAttempts = 3;
 // A cluster without viewpoints is sampled again after this many cycles, this many per cycle.
@@ -550,7 +555,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     bool found = search_.find_path(vehicle_, goal_view.position, guide, kMaxPathVoxels, waypoints, &expanded);
     ctx.counters->search_settled += expanded;
     if (!found && !guide.empty()) {
-      found = search_.find_path(vehicle_, goal_view.position, {}, kMaxPathVoxels, waypoints, &expanded);
+      found = search_.find_path(vehicle_, goal_view.position, {}, kMaxDetourVoxels, waypoints, &expanded);
       ctx.counters->search_settled += expanded;
     }
     ctx.counters->connect_ms += pw.ms();
