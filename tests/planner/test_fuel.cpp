@@ -627,6 +627,19 @@ TEST(Fuel, AStartFacingAWallTurnsInPlaceInsteadOfEndingDone) {
   }
 }
 
+// Skips every place of the box [lo, hi) on a 0.4 m lattice (a skip reaches min_view_distance,
+// 0.75 m, around its place) until `until`.
+void skip_places(Strategy& strategy, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int64_t until) {
+  for (double x = lo.x(); x < hi.x(); x += 0.4)
+    for (double y = lo.y(); y < hi.y(); y += 0.4)
+      for (double z = lo.z(); z < hi.z(); z += 0.4) {
+        Goal skip;
+        skip.valid = true;
+        skip.position = Eigen::Vector3d(x, y, z);
+        strategy.reject_goal(skip, until);
+      }
+}
+
 // SyntheticWorld::two_rooms known up to 1.5 m into the second room (x 0-4 and 4.2-8.2, y 0-4).
 void reveal_first_room(PlanScene& s) {
   SyntheticWorld::two_rooms().reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(5.7, 4.2, 2.7)});
@@ -809,14 +822,7 @@ TEST(Fuel, AViewNoPathReachesIsSkippedForGoodAtItsSecondFailureWhileRecovering) 
   auto scene = [&](PlanScene& s, FuelStrategy& fuel) {
     w.reveal(s.grid, {Eigen::Vector3d(-0.2, -0.2, -0.2), Eigen::Vector3d(6.7, 4.2, 2.7)});
     s.frontiers.reset(s.grid);
-    for (double x = -0.2; x < 3.5; x += 0.4)
-      for (double y = -0.2; y < 4.4; y += 0.4)
-        for (double z = 0.0; z < 2.8; z += 0.4) {
-          Goal g;
-          g.valid = true;
-          g.position = Eigen::Vector3d(x, y, z);
-          fuel.reject_goal(g, std::numeric_limits<int64_t>::max());
-        }
+    skip_places(fuel, {-0.2, -0.2, 0.0}, {3.5, 4.4, 2.8}, std::numeric_limits<int64_t>::max());
   };
   const auto plan_at = [&](FuelStrategy& fuel, PlanScene& s, int64_t cycle, bool recovering) {
     PlanContext ctx = s.context(at, 0.0, cycle);
@@ -894,14 +900,7 @@ TEST(Fuel, TheMainLoopWaitsForSkippedViewpointsBeforeDone) {
         (p.goal().position - Eigen::Vector3d(1.6, 2.4, 1.2)).norm() > 0.5) {
       // A tour goal is out: skip every place in the map until well past the recovery cycles.
       until = p.iteration() + 3 * c.loop.max_recovery_cycles;
-      for (double x = -0.5; x < 9.0; x += 0.4)
-        for (double y = -0.5; y < 4.5; y += 0.4)
-          for (double z = 0.0; z < 3.0; z += 0.4) {
-            Goal skip;
-            skip.valid = true;
-            skip.position = Eigen::Vector3d(x, y, z);
-            p.strategy().reject_goal(skip, until);
-          }
+      skip_places(p.strategy(), {-0.5, -0.5, 0.0}, {9.0, 4.5, 3.0}, until);
     }
     if (until < 0) continue;
     if (p.iteration() <= until) {
