@@ -4,14 +4,19 @@
 #include <cmath>
 
 #include "semx/core/angles.hpp"
+#include "semx/planner/travel_cost.hpp"
 
 #include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
 
 SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
-    : FuelStrategy(config), rules_(config.semantic_fuel), yaw_rate_(config.cost.yaw_rate) {
-  if (rules_.dep_first_s > 0) dep_ = std::make_unique<DepStrategy>(config, false);
+    : FuelStrategy(config),
+      rules_(config.semantic_fuel),
+      yaw_rate_(config.cost.yaw_rate),
+      cost_(config.cost),
+      gains_(config.gain) {
+  if (rules_.dep_first_s > 0 || rules_.greedy_ratio > 0) dep_ = std::make_unique<DepStrategy>(config, false);
 }
 
 std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
@@ -177,7 +182,7 @@ RoadmapView SemanticFuelStrategy::roadmap(const Goal* goal) const {
 
 PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
   if (first_utime_ < 0) first_utime_ = ctx.pose.utime;
-  if (dep_) {
+  if (rules_.dep_first_s > 0) {
     const bool was = dep_now_;
     dep_now_ = 1e-6 * static_cast<double>(ctx.pose.utime - first_utime_) < rules_.dep_first_s;
     if (dep_now_) return dep_->plan(ctx);
@@ -198,7 +203,54 @@ PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
       return o;
     }
   }
+  if (rules_.greedy_ratio > 0) return plan_greedy(ctx);
   return FuelStrategy::plan(ctx);
+}
+
+double SemanticFuelStrategy::dep_rate(PlanContext& ctx, const Goal& goal) {
+  gains_.set_ignored(ctx.unobservable);
+  GainStats stats;
+  const NodeGain g = gains_.evaluate(*ctx.grid, goal.position, &stats);
+  ctx.counters->gain_evaluations += stats.evaluations;
+  ctx.counters->rays += stats.rays;
+  ctx.counters->ray_steps += stats.steps;
+  const double gain = gains_.config().sweep ? gains_.sweep_gain(g, ctx.pose.yaw, gains_.window_of(goal.yaw))
+                                            : gains_.gain_at_yaw(g, goal.yaw);
+  double length = 0.0;
+  Eigen::Vector3d from = ctx.pose.position;
+  for (const Eigen::Vector3d& w : goal.waypoints) {
+    length += (w - from).norm();
+    from = w;
+  }
+  return node_score(gain, 0.0, travel_time(length, ctx.pose.yaw, goal.yaw, cost_));
+}
+
+PlanOutcome SemanticFuelStrategy::plan_greedy(PlanContext& ctx) {
+  const bool need = ctx.need_goal;
+  const Goal* flown = ctx.flown;
+  if (dep_now_ && !need && flown) {
+    // DEP's goal is flown as DEP flies it (its switches by the main loop's hysteresis) until it is
+    // no longer informative; then the next goal is chosen as at a goal reached.
+    if (dep_->goal_score(ctx, *flown)) return dep_->plan(ctx);
+    ctx.need_goal = true;
+    ctx.flown = nullptr;
+  }
+  PlanOutcome fuel = FuelStrategy::plan(ctx);
+  const bool choosing = ctx.need_goal || switched();
+  PlanOutcome out = std::move(fuel);
+  if (choosing && out.goal.valid) {
+    PlanContext d = ctx;
+    d.need_goal = true;
+    d.flown = nullptr;
+    PlanOutcome dep = dep_->plan(d);
+    dep_now_ = dep.goal.valid && dep.goal.score > rules_.greedy_ratio * dep_rate(ctx, out.goal);
+    if (dep_now_) out = std::move(dep);
+  } else if (choosing) {
+    dep_now_ = false;
+  }
+  ctx.need_goal = need;
+  ctx.flown = flown;
+  return out;
 }
 
 }  // namespace semx::planner

@@ -125,6 +125,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(semantic_fuel.doorway_first_cost);
   SAME(semantic_fuel.doorway_radius);
   SAME(semantic_fuel.dep_first_s);
+  SAME(semantic_fuel.greedy_ratio);
   SAME(semantic_fuel.object_weight);
   SAME(semantic_fuel.door_weight);
 #undef SAME

@@ -233,6 +233,40 @@ TEST(SemanticFuel, DepFirstFliesDepsGoalUntilItsTimeThenFuelsTour) {
   EXPECT_EQ(goal(later, d, 11000000).position, f.position) << "FUEL's tour after";
 }
 
+// The tour's first goal is the pocket on the cabinet (a few voxels); DEP's is toward the second
+// room, whose unknown space its gain counts. With greedy_ratio DEP's goal is flown when its G / T
+// is that many times the pocket's, and the pocket when no ratio that high is met.
+TEST(SemanticFuel, GreedyRatioFliesDepsGoalWhenItsRateIsThatManyTimesTheToursGoal) {
+  auto goal = [](double ratio) {
+    PocketScene s;
+    s.regions = {s.cabinet()};
+    s.config.semantic_fuel.greedy_ratio = ratio;
+    SemanticFuelStrategy sem(s.config);
+    PlanContext ctx = s.context({1.6, 2.4, 1.2}, 0.5 * core::kPi);
+    ctx.min_gain = s.config.gain.min_gain;
+    ctx.need_goal = true;
+    return sem.plan(ctx).goal;
+  };
+  PocketScene a;
+  a.regions = {a.cabinet()};
+  DepStrategy dep(a.config, false);
+  PlanContext actx = a.context({1.6, 2.4, 1.2}, 0.5 * core::kPi);
+  actx.min_gain = a.config.gain.min_gain;
+  actx.need_goal = true;
+  const Goal d = dep.plan(actx).goal;
+  ASSERT_TRUE(d.valid);
+  ASSERT_FALSE(a.at_pocket(d.position)) << "the scene is meant to tell DEP's goal from the tour's";
+
+  const Goal tour = goal(1e6);
+  ASSERT_TRUE(tour.valid);
+  EXPECT_LT((tour.position - a.pocket).norm(), a.config.fuel.view_radius_max + 0.1)
+      << "no ratio met: the tour's goal, the pocket's view " << tour.position.transpose();
+  const Goal greedy = goal(2.0);
+  ASSERT_TRUE(greedy.valid);
+  EXPECT_LT((greedy.position - d.position).norm(), 1e-9) << "DEP's goal: " << greedy.position.transpose();
+  EXPECT_DOUBLE_EQ(greedy.score, d.score);
+}
+
 TEST(SemanticFuel, NearAnUnfinishedObjectIsWithinItsBoxAndMargin) {
   SemanticRegion r;
   r.class_id = static_cast<int>(runtime::SemanticClass::kTable);

@@ -71,6 +71,8 @@ class FuelStrategy : public Strategy {
   const std::vector<int64_t>& tour() const { return tour_; }
   // Why the last plan() planned again ("" when it kept the goal).
   const std::string& replan_reason() const { return replan_reason_; }
+  // Whether the last plan() chose a new goal, which supersedes the one flown (goal_score()).
+  bool switched() const { return switch_; }
 
  protected:
   // A hook for planners built on FUEL's tour (semantic_fuel_strategy.hpp): extra costs (s) added to

@@ -226,6 +226,12 @@ struct SemanticFuelConfig {
   // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
   // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
   double dep_first_s = 0.0;
+  // Not semantic: whenever FUEL's tour picks its next goal, DEP's best goal is flown instead when
+  // its G / T is greedy_ratio times that of the tour's goal, both in DEP's measure (the volumetric
+  // gain in the goal's yaw window over the travel time): the tour sees frontier clusters, and a
+  // doorway's is small while the room behind it is not. DEP's goal is flown until it is reached
+  // or no longer informative. 0: off.
+  double greedy_ratio = 0.0;
   // With fuel.latency_tour: what an object not yet fully observed is worth in the tour's order. A
   // site's weight (its coverage) is multiplied by 1 + object_weight × the share of its cluster's
   // voxels within object_margin of such an object's box, so the tour sees the unseen sides of

@@ -12,7 +12,8 @@
 //  - doorway clusters (door_clusters, off: it lost): a small cluster within doorway_radius of a
 //    door region is toured with the large ones, as a pocket is: a doorway's frontier is small, the
 //    room behind it is not;
-//  - and doorways first, start turns, DEP first (SemanticFuelConfig says what each does).
+//  - and doorways first, start turns, DEP first, DEP when far better (SemanticFuelConfig says what
+//    each does).
 // Everything else is FUEL's, unchanged.
 #pragma once
 
@@ -42,13 +43,21 @@ class SemanticFuelStrategy : public FuelStrategy {
                       const std::vector<Eigen::Vector3d>& reps, const std::vector<Eigen::Vector3d>& means,
                       TourProblem& problem) const override;
   bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
+  // greedy_ratio: FUEL's choice, or DEP's when its G / T is that many times the tour goal's.
+  PlanOutcome plan_greedy(PlanContext& ctx);
+  // A goal's G / T in DEP's measure: the gain in its yaw window (swept from the vehicle's yaw as
+  // DEP's scores are, with gain.sweep) over the travel time along its waypoints.
+  double dep_rate(PlanContext& ctx, const Goal& goal);
   double latency_weight(const PlanContext& ctx, const FrontierClusters::Cluster& cluster,
                         double coverage) const override;
 
  private:
   SemanticFuelConfig rules_;
   double yaw_rate_;
-  // dep_first_s: DEP's roadmap decides until then (it is fed the map all along).
+  CostConfig cost_;
+  GainEvaluator gains_;  // dep_rate()
+  // dep_first_s: DEP's roadmap decides until then (it is fed the map all along); greedy_ratio: it
+  // decides while its goal is flown.
   std::unique_ptr<DepStrategy> dep_;
   int64_t first_utime_ = -1;
   bool dep_now_ = false;
