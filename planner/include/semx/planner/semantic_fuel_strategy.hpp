@@ -43,15 +43,16 @@ class SemanticFuelStrategy : public FuelStrategy {
                       const std::vector<Eigen::Vector3d>& reps, const std::vector<Eigen::Vector3d>& means,
                       TourProblem& problem) const override;
   bool promoted(const PlanContext& ctx, const FrontierClusters::Cluster& cluster) const override;
+  double latency_weight(const PlanContext& ctx, const FrontierClusters::Cluster& cluster,
+                        double coverage) const override;
+
+ private:
   // greedy_ratio: FUEL's choice, or DEP's when its G / T is that many times the tour goal's.
   PlanOutcome plan_greedy(PlanContext& ctx);
   // A goal's G / T in DEP's measure: the gain in its yaw window (swept from the vehicle's yaw as
   // DEP's scores are, with gain.sweep) over the travel time along its waypoints.
   double dep_rate(PlanContext& ctx, const Goal& goal);
-  double latency_weight(const PlanContext& ctx, const FrontierClusters::Cluster& cluster,
-                        double coverage) const override;
 
- private:
   SemanticFuelConfig rules_;
   double yaw_rate_;
   CostConfig cost_;
