@@ -695,8 +695,7 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   const double reward = reward_at(ctx, n.position, goal.yaw);
   // The goal keeps the yaw it was chosen with (its best yaw may have moved since); with the sweep
   // it is worth what the rest of the turn to that yaw sweeps.
-  const double g = config_.gain.sweep ? gains_.sweep_gain(n.gain, ctx.pose.yaw, gains_.window_of(goal.yaw))
-                                      : gains_.gain_at_yaw(n.gain, goal.yaw);
+  const double g = gains_.goal_gain(n.gain, ctx.pose.yaw, goal.yaw);
   return node_score(
       g, reward,
       travel_time(search_.distance[static_cast<size_t>(goal.node)], ctx.pose.yaw, goal.yaw, config_.cost));

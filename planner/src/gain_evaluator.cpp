@@ -259,6 +259,10 @@ double GainEvaluator::gain_at_yaw(const NodeGain& g, double yaw) const {
   return s;
 }
 
+double GainEvaluator::goal_gain(const NodeGain& g, double from_yaw, double yaw) const {
+  return config_.sweep ? sweep_gain(g, from_yaw, window_of(yaw)) : gain_at_yaw(g, yaw);
+}
+
 void GainEvaluator::sweep_gains(const NodeGain& g, double from_yaw, std::vector<double>& out) const {
   const int bins = config_.yaw_bins;
   out.assign(static_cast<size_t>(bins), 0.0);

@@ -214,8 +214,7 @@ double SemanticFuelStrategy::dep_rate(PlanContext& ctx, const Goal& goal) {
   ctx.counters->gain_evaluations += stats.evaluations;
   ctx.counters->rays += stats.rays;
   ctx.counters->ray_steps += stats.steps;
-  const double gain = gains_.config().sweep ? gains_.sweep_gain(g, ctx.pose.yaw, gains_.window_of(goal.yaw))
-                                            : gains_.gain_at_yaw(g, goal.yaw);
+  const double gain = gains_.goal_gain(g, ctx.pose.yaw, goal.yaw);
   double length = 0.0;
   Eigen::Vector3d from = ctx.pose.position;
   for (const Eigen::Vector3d& w : goal.waypoints) {
@@ -235,9 +234,8 @@ PlanOutcome SemanticFuelStrategy::plan_greedy(PlanContext& ctx) {
     ctx.need_goal = true;
     ctx.flown = nullptr;
   }
-  PlanOutcome fuel = FuelStrategy::plan(ctx);
+  PlanOutcome out = FuelStrategy::plan(ctx);
   const bool choosing = ctx.need_goal || switched();
-  PlanOutcome out = std::move(fuel);
   if (choosing && out.goal.valid) {
     PlanContext d = ctx;
     d.need_goal = true;

@@ -90,6 +90,9 @@ class GainEvaluator {
   void finish(NodeGain& g) const;
   // Gain of the window centred nearest to `yaw`.
   double gain_at_yaw(const NodeGain& g, double yaw) const;
+  // What a goal at `yaw` is worth to a vehicle now at `from_yaw`: with gain.sweep what the turn
+  // sweeps on its way there (sweep_gain), else the window's gain (gain_at_yaw). DEP scores goals so.
+  double goal_gain(const NodeGain& g, double from_yaw, double yaw) const;
   // What a camera turning at the node from `from_yaw` to the window starting at bin `to_window`,
   // the shorter way, sees: every bin of every window it passes, each once (all bins when the
   // turn and the window together span them). sweep_gains() fills this for every window at once.
