@@ -3,10 +3,13 @@
 // registers again with a new master; external mode turns ROS sensors into semx's messages and
 // semx's commands into MAVROS setpoints. Each test runs its own roscore on a private port.
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
+#include <sys/socket.h>
 #include <tf2_msgs/TFMessage.h>
+#include <unistd.h>
 
 #include <semx/camera_info_t.hpp>
 #include <semx/clock_t.hpp>
@@ -27,7 +30,9 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <set>
 
@@ -49,7 +54,32 @@ using semx::rosbridge::from_ros_msg;
 
 namespace {
 
-int ros_port() { return test_port(1); }
+// The master's TCP port, chosen once per process. Below the kernel's ephemeral range (32768 up):
+// test_port's range reaches into it, and a client socket that happens to hold the port makes
+// roscore exit with "port ... is already in use" (a CI run lost a test that way). A candidate
+// that cannot be bound now is skipped, as roscore's own bind would fail on it.
+bool tcp_port_free(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return false;
+  const int one = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);  // as roscore's server does
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  const bool ok = ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  ::close(fd);
+  return ok;
+}
+int ros_port() {
+  static const int port = [] {
+    const int base = 12000 + (static_cast<int>(getpid()) % 1500) * 10;
+    for (int k = 1; k < 10; ++k)
+      if (tcp_port_free(base + k)) return base + k;
+    return base + 1;  // roscore's log then says why it did not start
+  }();
+  return port;
+}
 std::string lcm_url() { return runtime::udpm_url_for_port(test_port(0)); }
 std::string log_dir() {
   const std::string d = ::testing::TempDir() + "/semx_ros_live_" + std::to_string(getpid());
@@ -81,6 +111,13 @@ class RosCore {
   }
   ~RosCore() { stop(); }
   bool up() const { return up_; }
+  // For a failed start: the port and the end of roscore's log.
+  std::string why() const {
+    std::ifstream f(log_dir() + "/roscore.log");
+    const std::string log((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    return "roscore on port " + std::to_string(ros_port()) + " did not answer; its log ends:\n" +
+           log.substr(log.size() > 1500 ? log.size() - 1500 : 0);
+  }
   // roslaunch stops the master and rosout on SIGINT; then nothing answers on the port.
   void stop() {
     if (!core_) return;
@@ -354,7 +391,7 @@ const std::vector<std::string> kMirrorTopics{
 
 TEST(RosBridgeLive, MirrorPublishesEveryTopicWithItsTypeFrameAndContent) {
   RosCore core;
-  ASSERT_TRUE(core.up()) << "roscore did not start (log: " << log_dir() << "/roscore.log)";
+  ASSERT_TRUE(core.up()) << core.why();
   auto bridge = start_bridge("bridge_mirror");
   FakeSet set;
   Listener ros;
@@ -422,7 +459,7 @@ TEST(RosBridgeLive, MirrorPublishesEveryTopicWithItsTypeFrameAndContent) {
 
 TEST(RosBridgeLive, TheLcmSideGoesOnWithoutAMasterAndTheBridgeRegistersWithTheNextOne) {
   auto core = std::make_unique<RosCore>();
-  ASSERT_TRUE(core->up());
+  ASSERT_TRUE(core->up()) << core->why();
   auto bridge = start_bridge("bridge_restart");
   FakeSet set;
   // The bridge's NODE_STATUS: its LCM side's state and how many messages it handled.
@@ -453,7 +490,7 @@ TEST(RosBridgeLive, TheLcmSideGoesOnWithoutAMasterAndTheBridgeRegistersWithTheNe
   EXPECT_TRUE(bridge->alive());
 
   core = std::make_unique<RosCore>();
-  ASSERT_TRUE(core->up());
+  ASSERT_TRUE(core->up()) << core->why();
   Listener again;  // this process's node must subscribe anew with the new master too
   again.subscribe();
   EXPECT_TRUE(spin_until(again.queue, &set.node, 30, [&] {
@@ -468,7 +505,7 @@ TEST(RosBridgeLive, TheLcmSideGoesOnWithoutAMasterAndTheBridgeRegistersWithTheNe
 
 TEST(RosBridgeLive, ExternalModeFeedsSemxFromRosAndSendsSetpoints) {
   RosCore core;
-  ASSERT_TRUE(core.up());
+  ASSERT_TRUE(core.up()) << core.why();
   auto bridge = start_bridge("bridge_external", {"--mode", "external", "--set", "setpoints.mode=both"});
   runtime::Node lcm = make_lcm_node("external_test");
   std::vector<semx::odometry_t> odometry;
