@@ -78,6 +78,11 @@ say "recording a $time_limit s $world run (real time) to $out/sensors.bag"
   >"$out/logs/demo.log" 2>&1 || { say "the simulated run failed (logs in $out/original/logs)"; tail -20 "$out/logs/demo.log"; exit 1; }
 sleep 2
 kill -INT "$recorder"; wait "$recorder" || true
+# rosbag record is a Python wrapper that passes SIGINT to its recorder child and exits at once; the
+# child then closes the bag and renames sensors.bag.active to sensors.bag (a test lost a run to
+# reading the bag before that).
+bag_closed() { [ -f "$out/sensors.bag" ] && [ ! -e "$out/sensors.bag.active" ]; }
+wait_for 30 bag_closed || { say "rosbag record did not close $out/sensors.bag"; exit 1; }
 kill -INT "$bridge"; wait "$bridge" || true
 # The demo set's mapper checkpoints into the run folder (where a restarted mapper resumes from).
 original_ckpt=$out/original/state/mapper.ckpt
