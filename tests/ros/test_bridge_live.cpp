@@ -491,7 +491,16 @@ TEST(RosBridgeLive, TheLcmSideGoesOnWithoutAMasterAndTheBridgeRegistersWithTheNe
 
   core = std::make_unique<RosCore>();
   ASSERT_TRUE(core->up()) << core->why();
-  Listener again;  // this process's node must subscribe anew with the new master too
+  // This process's node must subscribe anew with the new master too. roscpp keeps one
+  // subscription per topic and process, registered with the master it was made with: a second
+  // Subscriber beside the first one's would never reach the new master and would only get data
+  // through the old link's reconnect to the bridge, whose back-off outlasted the wait on a loaded
+  // machine. So the first listener lets go of its topics first (`keep` holds the node up
+  // meanwhile: with its last NodeHandle gone roscpp would shut the node down).
+  ::ros::NodeHandle keep;
+  ros.subs.clear();
+  ros.nh.reset();
+  Listener again;
   again.subscribe();
   EXPECT_TRUE(spin_until(again.queue, &set.node, 30, [&] {
     return again.count["/semx/odom"] > 0 && again.count["/semx/map"] > 0 && state == semx::node_status_t::RUNNING;
