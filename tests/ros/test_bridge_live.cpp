@@ -56,8 +56,9 @@ namespace {
 
 // The master's TCP port, chosen once per process. Below the kernel's ephemeral range (32768 up):
 // test_port's range reaches into it, and a client socket that happens to hold the port makes
-// roscore exit with "port ... is already in use" (a CI run lost a test that way). A candidate
-// that cannot be bound now is skipped, as roscore's own bind would fail on it.
+// roscore exit with "port ... is already in use" (one way for a roscore never to answer, as one
+// did in a CI run whose log was lost). A candidate that cannot be bound now is skipped, as
+// roscore's own bind would fail on it.
 bool tcp_port_free(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   if (fd < 0) return false;
