@@ -369,6 +369,7 @@ void ExplorationPlanner::run_cycle(int64_t utime) {
       << o.goal.score;
     if (o.tour_stops > 0) s << " (end game: first of a tour of " << o.tour_stops << " stops)";
     if (o.pocket_stops > 0) s << " (first of " << o.pocket_stops << " pockets before a far goal)";
+    if (o.goal.look) s << " (a look across a cut of the roadmap)";
     reason = s.str();
   } else if (need) {
     if (why == "path blocked") {

@@ -140,6 +140,9 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   l.get("hysteresis", c.loop.hysteresis, 1.0, 1e6);
   l.get("done_cycles", c.loop.done_cycles, 1, 1000000);
   l.get("max_recovery_cycles", c.loop.max_recovery_cycles, 1, 1000000);
+  l.get("cut_looks", c.loop.cut_looks, 0, 1000);
+  l.get("cut_look_cycles", c.loop.cut_look_cycles, 1, 1000000);
+  l.get("cut_look_nodes", c.loop.cut_look_nodes, 1, 1000000);
   l.get("blacklist_cycles", c.loop.blacklist_cycles, 0, 1000000);
   l.get("visited_cycles", c.loop.visited_cycles, 0, 1000000);
   l.get("max_start_offset", c.loop.max_start_offset, 0.0, 100.0);

@@ -149,6 +149,11 @@ class DepStrategy : public Strategy {
   // vehicle through informative nodes to `far` (the score's goal) whose time exceeds the direct
   // trip's by at most pocket_detour x that trip; invalid when no pocket fits. `stops`: the pockets.
   Goal pocket_goal(PlanContext& ctx, const Goal& far, const ScoreFn& score, int* stops);
+  // Recovery (loop.cut_looks): the reachable node nearest an unreachable node joined to an
+  // informative one, with no occupied voxel on the line between them and not within 1 m of a
+  // place looked from before, as a goal facing that node; invalid when none. Uses
+  // this cycle's search_.
+  Goal cut_look_goal(PlanContext& ctx) const;
   // A tour's stop as the goal: the node at its best window, the roadmap path to it.
   Goal stop_goal(PlanContext& ctx, const ScoreFn& score, int64_t id);
 
@@ -161,6 +166,12 @@ class DepStrategy : public Strategy {
   int64_t root_ = -1;
   std::set<map::VoxelKey> changed_blocks_;  // since the last cycle
   std::set<int64_t> reapproached_;          // passage nodes given approaches in this recovery
+  int idle_cycles_ = 0;                     // cycles that needed a goal and found none, in a row
+  // Places looked across a cut from, for the whole run: a look that did not open the cut would
+  // not open it the next time either (the 396 m² world with noise looked from the same three
+  // places again after each goal between them), and a cut that came back there has other places.
+  std::vector<Eigen::Vector3d> looked_;
+  int looks_now_ = 0;  // looks since the last real goal
   // Voxels that became occupied or unknown since the last cycle, by block.
   std::map<map::VoxelKey, std::vector<map::VoxelKey>> obstacle_voxels_;
   bool full_reset_ = false;

@@ -66,6 +66,10 @@ struct Goal {
   // loop flies it until it is reached or no longer informative, without switching on score (every
   // pocket scores below the far goal it was put before).
   bool held = false;
+  // A look across a cut of the roadmap (DEP's recovery, loop.cut_looks): flown to re-observe the
+  // passage between the vehicle's part of the roadmap and informative nodes it cannot reach; it
+  // promises no gain, and any goal that scores at all replaces it.
+  bool look = false;
 };
 
 // A turn in place at `at` by `turn` rad from `from_yaw`: its cost the turn's time at `yaw_rate`,
