@@ -749,6 +749,99 @@ TEST(DepRoadmap, RecoveryPutsAPassageNodeInADoorwayCrowdedByNodesOnBothSides) {
   EXPECT_EQ(dep.try_insert(recovering, dep.graph().node(id).position + Eigen::Vector3d(0.05, 0, 0)), -1);
 }
 
+// Two known rooms split at x = 4 by a wall whose only opening is a slot 0.4 m wide (free voxel
+// centres y 1.85-2.15), the vehicle in the near one at (1, 2, 1.2), its roadmap planned once; no
+// node or edge fits through the slot (a doorway whose jambs noise mapped too wide). With `slot`
+// false the wall is whole. Then `informative` nodes on the far side, joined to each other and not
+// to the vehicle's part, with a cached gain far above min_gain.
+void cut_off_far_room(DepFixture& f, DepStrategy& dep, bool slot, int informative) {
+  fill_m(f.grid, {-0.05, -0.05, -0.05}, {8.05, 4.05, 2.55}, VoxelState::kOccupied);
+  fill_m(f.grid, {0.05, 0.05, 0.05}, {7.95, 3.95, 2.45}, VoxelState::kFree);
+  fill_m(f.grid, {3.95, 0.05, 0.05}, {4.05, 3.95, 2.45}, VoxelState::kOccupied);
+  if (slot) fill_m(f.grid, {3.95, 1.8, 0.05}, {4.05, 2.2, 2.45}, VoxelState::kFree);
+  f.frontiers.reset(f.grid);
+  dep.on_map_reset();
+  PlanContext ctx = f.context({1.0, 2.0, 1.2});
+  ctx.need_goal = true;
+  dep.plan(ctx);
+  std::vector<int64_t> far;
+  for (int i = 0; i < informative; ++i) {
+    far.push_back(dep.graph().add_node({4.6 + 0.8 * (i / 3), 1.0 + (i % 3), 1.2}));
+    RoadmapNode& n = dep.graph().node(far.back());
+    n.gain.valid = true;
+    n.gain.gain = 50.0 * f.config.gain.min_gain;
+    n.gain_stale = false;
+    if (far.size() > 1) dep.graph().add_edge(far[far.size() - 2], far.back(), 1.0);
+  }
+}
+
+// Plans `cycles` cycles that need a goal, the vehicle where cut_off_far_room put it (it does not
+// fly: a look it is given stays a place to look from); returns the goals, and when cut off
+// records the least number of informative nodes cut off.
+std::vector<std::pair<int64_t, Goal>> plan_without_flying(DepFixture& f, DepStrategy& dep, int cycles,
+                                                          int64_t* cut_off = nullptr) {
+  std::vector<std::pair<int64_t, Goal>> goals;
+  for (int64_t c = 2; c < 2 + cycles; ++c) {
+    PlanContext ctx = f.context({1.0, 2.0, 1.2}, 0.0, c);
+    ctx.need_goal = true;
+    ctx.recovering = true;
+    const PlanOutcome o = dep.plan(ctx);
+    if (cut_off) *cut_off = std::min(*cut_off, o.unreachable_informative);
+    if (o.goal.valid) {
+      goals.emplace_back(c, o.goal);
+      EXPECT_EQ(dep.goal_score(ctx, o.goal), std::optional<double>(0.0)) << "a look promises nothing";
+    }
+  }
+  return goals;
+}
+
+TEST(DepRoadmap, RecoveryLooksAcrossACutFromTheNearestPlaceWithAnOpenLine) {
+  DepFixture f;
+  DepStrategy dep(f.config, false);
+  cut_off_far_room(f, dep, true, 12);
+  int64_t cut_off = std::numeric_limits<int64_t>::max();
+  const auto goals = plan_without_flying(f, dep, 4 * f.config.loop.cut_look_cycles, &cut_off);
+  EXPECT_EQ(cut_off, 12) << "relinking and sampling never cross the slot";
+  ASSERT_FALSE(goals.empty());
+  const auto& [cycle, look] = goals.front();
+  EXPECT_TRUE(look.look);
+  // Relinking had its cycles first: the look is the cut_look_cycles-th cycle without a goal
+  // (cycles 1 to cut_look_cycles; the first is cut_off_far_room's).
+  EXPECT_EQ(cycle, f.config.loop.cut_look_cycles);
+  EXPECT_LT(look.position.x(), 3.95) << "from the vehicle's side";
+  // Facing the far room through the slot.
+  ASSERT_GT(std::cos(look.yaw), 0.0);
+  const double y = look.position.y() + (4.0 - look.position.x()) * std::tan(look.yaw);
+  EXPECT_GT(y, 1.8);
+  EXPECT_LT(y, 2.2);
+  ASSERT_GE(look.waypoints.size(), 2u);
+  EXPECT_LT((look.waypoints.front() - Eigen::Vector3d(1.0, 2.0, 1.2)).norm(), 1e-9);
+  EXPECT_LT((look.waypoints.back() - look.position).norm(), 1e-9);
+  EXPECT_EQ(look.yaws.back(), look.yaw);
+  // Never twice from one place, and at most cut_looks of them while no real goal comes.
+  EXPECT_LE(static_cast<int>(goals.size()), f.config.loop.cut_looks);
+  for (size_t i = 0; i < goals.size(); ++i) {
+    EXPECT_TRUE(goals[i].second.look);
+    for (size_t j = 0; j < i; ++j)
+      EXPECT_GE((goals[i].second.position - goals[j].second.position).norm(), 1.0) << i << " " << j;
+  }
+}
+
+TEST(DepRoadmap, NoLookAcrossAWallAPocketOrWithTheRuleOff) {
+  for (const char* scene : {"wall", "pocket", "off"}) {
+    SCOPED_TRACE(scene);
+    DepFixture f;
+    if (std::string(scene) == "off") f.config.loop.cut_looks = 0;
+    DepStrategy dep(f.config, false);
+    // A part of fewer informative nodes than cut_look_nodes is a pocket behind furniture.
+    const int informative = std::string(scene) == "pocket" ? f.config.loop.cut_look_nodes - 1 : 12;
+    cut_off_far_room(f, dep, std::string(scene) != "wall", informative);
+    int64_t cut_off = std::numeric_limits<int64_t>::max();
+    EXPECT_TRUE(plan_without_flying(f, dep, 4 * f.config.loop.cut_look_cycles, &cut_off).empty());
+    EXPECT_EQ(cut_off, informative);
+  }
+}
+
 TEST(DepRoadmap, ChangedSpaceMakesNearbyGainsStale) {
   DepFixture f;
   corridor(f.grid);
