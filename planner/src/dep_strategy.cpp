@@ -32,6 +32,8 @@ void DepStrategy::reset() {
   root_ = -1;
   changed_blocks_.clear();
   reapproached_.clear();
+  idle_cycles_ = looks_now_ = 0;
+  looked_.clear();
   obstacle_voxels_.clear();
   full_reset_ = false;
   search_ = Roadmap::Search();

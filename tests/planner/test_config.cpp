@@ -68,6 +68,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(loop.max_recovery_cycles);
   SAME(loop.cut_looks);
   SAME(loop.cut_look_cycles);
+  SAME(loop.cut_look_nodes);
   SAME(loop.blacklist_cycles);
   SAME(loop.visited_cycles);
   SAME(loop.max_start_offset);

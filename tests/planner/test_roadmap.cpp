@@ -825,6 +825,12 @@ TEST(DepRoadmap, RecoveryLooksAcrossACutFromTheNearestPlaceWithAnOpenLine) {
     for (size_t j = 0; j < i; ++j)
       EXPECT_GE((goals[i].second.position - goals[j].second.position).norm(), 1.0) << i << " " << j;
   }
+  // A new episode starts with no place looked from.
+  dep.reset();
+  cut_off_far_room(f, dep, true, 12);
+  const auto again = plan_without_flying(f, dep, f.config.loop.cut_look_cycles);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_TRUE(again.front().second.look);
 }
 
 TEST(DepRoadmap, NoLookAcrossAWallAPocketOrWithTheRuleOff) {

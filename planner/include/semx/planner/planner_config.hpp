@@ -255,10 +255,11 @@ struct LoopConfig {
   // DEP-family recovery: when informative nodes are cut off and relinking has not joined them
   // for cut_look_cycles cycles, fly to the reachable node nearest an unreachable one across open
   // space (no occupied voxel on the line between them) and look across the cut, at most
-  // cut_looks times between two real goals and never twice from one place (1 m). Depth noise maps a doorway's
-  // jambs a voxel too wide after the vehicle has passed, and only the camera clears them (the 396 m² world of
-  // the 24-world set with noise: DONE at 96.6 % with 950 informative nodes behind a doorway mapped 0.7 m
-  // wide; docs/planner.md "Recovery and termination"). 0: off.
+  // cut_looks times between two real goals and never twice from one place (1 m). Depth noise
+  // maps a doorway's jambs a voxel too wide after the vehicle has passed, and only the camera
+  // clears them (the 396 m² world of the 24-world set with noise: DONE at 96.6 % with 950
+  // informative nodes behind a doorway mapped 0.7 m wide; docs/planner.md "A look across the
+  // cut"). 0: off.
   int cut_looks = 4;
   int cut_look_cycles = 8;
   int cut_look_nodes = 10;    // informative nodes a part cut off must hold to be looked at
