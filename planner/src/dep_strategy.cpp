@@ -681,7 +681,7 @@ Goal DepStrategy::cut_look_goal(PlanContext& ctx) const {
   // The unreachable parts worth reaching: each part of the roadmap the vehicle cannot reach
   // that holds at least cut_look_nodes informative nodes. A node or two cut off is a pocket
   // behind furniture (on a cabinet, under a table), which no look opens: in the 396 m² world with
-  // noise, six of seven looks went to such parts, of one or two informative nodes each.
+  // noise, seven of nine looks went to such parts, of one informative node each.
   const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
   auto informative = [&](const RoadmapNode& n) { return n.gain.valid && n.gain.gain >= min_gain; };
   std::vector<char> wanted(graph_.slots().size(), 0), seen(graph_.slots().size(), 0);
