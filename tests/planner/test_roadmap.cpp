@@ -819,6 +819,7 @@ TEST(DepRoadmap, RecoveryLooksAcrossACutFromTheNearestPlaceWithAnOpenLine) {
   EXPECT_LT((look.waypoints.back() - look.position).norm(), 1e-9);
   EXPECT_EQ(look.yaws.back(), look.yaw);
   // Never twice from one place, and at most cut_looks of them while no real goal comes.
+  EXPECT_GE(goals.size(), 2u) << "places 1 m apart from the first with an open line";
   EXPECT_LE(static_cast<int>(goals.size()), f.config.loop.cut_looks);
   for (size_t i = 0; i < goals.size(); ++i) {
     EXPECT_TRUE(goals[i].second.look);
