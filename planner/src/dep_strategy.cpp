@@ -703,18 +703,6 @@ Goal DepStrategy::cut_look_goal(PlanContext& ctx) const {
     if (count < config_.loop.cut_look_nodes) continue;
     for (int64_t id : part) wanted[static_cast<size_t>(id)] = 1;
   }
-  // A wall between the two sides is no cut a look can open; a doorway whose jambs were mapped too
-  // wide, or unknown voxels in it, are.
-  const double step = 0.5 * ctx.grid->resolution();
-  auto open = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    const int steps = static_cast<int>(std::ceil((b - a).norm() / step));
-    for (int i = 0; i <= steps; ++i) {
-      if (ctx.grid->state(a + (b - a) * (static_cast<double>(i) / std::max(steps, 1))) ==
-          VoxelState::kOccupied)
-        return false;
-    }
-    return true;
-  };
   int64_t from = -1;
   Eigen::Vector3d toward = Eigen::Vector3d::Zero();
   double best = std::numeric_limits<double>::infinity();
@@ -727,7 +715,9 @@ Goal DepStrategy::cut_look_goal(PlanContext& ctx) const {
       if (d >= best) break;
       const bool seen = std::any_of(looked_.begin(), looked_.end(),
                                     [&](const Eigen::Vector3d& p) { return (p - n.position).norm() < 1.0; });
-      if (seen || !open(n.position, b.position)) continue;
+      // A wall between the two sides is no cut a look can open; a doorway whose jambs were mapped
+      // too wide, or unknown voxels in it, are: the line between them crosses no occupied voxel.
+      if (seen || !ctx.grid->is_visible(n.position, b.position)) continue;
       best = d;
       from = a;
       toward = b.position;
