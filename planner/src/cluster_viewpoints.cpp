@@ -106,7 +106,7 @@ std::vector<Viewpoint> ViewpointSampler::sample(const map::StateGrid& grid, cons
       if (r > 0.1) radii.push_back(r);
     try_heights();
   }
-  if (out.empty() && fuel_.view_radius_steps > 1) {
+  if (out.empty() && fuel_.far_rings && fuel_.view_radius_steps > 1) {
     // Rings beyond FUEL's, out to the camera's range: a cluster seen from afar through a doorway
     // has FUEL's rings all in the unknown room around it, and the known space it can be seen from
     // is farther. Without them the tour ran dry with such clusters left and the run ended DONE

@@ -499,6 +499,53 @@ TEST(Viewpoints, TheCameraDoesNotSeeThroughWalls) {
   EXPECT_EQ(sampler.view_from(g, {open}, 1.0, from, nullptr).coverage, 1.0);
 }
 
+TEST(Viewpoints, AClusterSeenThroughADoorwayFromAfarGetsAViewOnTheFarRingsAndOnlyThen) {
+  // A room known free, a wall with a doorway, and behind it only a slot 0.4 m wide seen through
+  // the doorway (too narrow to hover in): the slot's far clusters have FUEL's rings in the unknown
+  // room, and are seen from the known room 3-4.5 m away.
+  map::StateGrid g(0.1);
+  fill_m(g, {0.0, 0.0, 0.0}, {4.0, 4.0, 2.5}, VoxelState::kFree);
+  fill_m(g, {4.0, 0.0, 0.0}, {4.1, 4.0, 2.5}, VoxelState::kOccupied);
+  fill_m(g, {4.0, 1.5, 0.0}, {4.1, 2.5, 2.5}, VoxelState::kFree);
+  fill_m(g, {4.1, 1.8, 0.0}, {8.5, 2.2, 2.5}, VoxelState::kFree);
+  PlannerConfig c = test_config("fuel");
+  FrontierTracker tracker;
+  tracker.reset(g);
+  FrontierClusters fc(0.1, c.fuel.min_cluster_voxels, c.fuel.split_radius);
+  const auto& all = tracker.voxels();
+  fc.rebuild({all.begin(), all.end()}, [&](const VoxelKey& k) { return tracker.contains(k) && k.z >= 4; });
+  CollisionChecker checker(c.collision);
+  checker.set_grid(&g);
+  GainEvaluator gains(c.gain);
+  PlannerConfig off = c;
+  off.fuel.far_rings = false;
+  ViewpointSampler with_far(c, checker, gains), without(off, checker, gains);
+  int far_only = 0, near_same = 0;
+  for (const auto& [id, cl] : fc.clusters()) {
+    const std::vector<Viewpoint> a = with_far.sample(g, cl, nullptr, 0.0);
+    const std::vector<Viewpoint> b = without.sample(g, cl, nullptr, 0.0);
+    if (!b.empty()) {
+      // A cluster with a view on FUEL's rings keeps exactly those views.
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].position, b[i].position);
+      ++near_same;
+      continue;
+    }
+    if (cl.mean.x() < 5.5 || a.empty()) continue;
+    ++far_only;
+    for (const Viewpoint& v : a) {
+      EXPECT_TRUE(checker.node_free(v.position));
+      EXPECT_LT(v.position.x(), 4.0) << "in the known room";
+      EXPECT_GE(v.coverage, c.fuel.min_coverage);
+      const double r = (v.position - cl.mean).head<2>().norm();
+      EXPECT_GT(r, c.fuel.view_radius_max) << "on a far ring";
+      EXPECT_LT(r, c.gain.max_range);
+    }
+  }
+  EXPECT_GT(far_only, 0) << "a far cluster in the slot has views only on the far rings";
+  EXPECT_GT(near_same, 0) << "and some cluster had views on FUEL's rings";
+}
+
 // ---------------------------------------------------------------- yaws
 
 TEST(Fuel, LongSegmentsAreSplitBelowTheControllersLimit) {
