@@ -57,8 +57,9 @@ Viewpoint ViewpointSampler::view_from(const map::StateGrid& grid, const std::vec
   return v;
 }
 
-std::vector<Viewpoint> ViewpointSampler::sample(const map::StateGrid& grid, const FrontierClusters::Cluster& cluster,
-                                                CycleCounters* counters, double phase) const {
+std::vector<Viewpoint> ViewpointSampler::sample(const map::StateGrid& grid,
+                                                const FrontierClusters::Cluster& cluster,
+                                                CycleCounters* counters, double phase, bool far) const {
   std::vector<Viewpoint> out;
   if (cluster.voxels.empty()) return out;
   // The voxels tested for visibility: every n-th in key order, which spreads them over the cluster.
@@ -106,11 +107,10 @@ std::vector<Viewpoint> ViewpointSampler::sample(const map::StateGrid& grid, cons
       if (r > 0.1) radii.push_back(r);
     try_heights();
   }
-  if (out.empty() && fuel_.far_rings && fuel_.view_radius_steps > 1) {
+  if (out.empty() && far && fuel_.view_radius_steps > 1) {
     // Rings beyond FUEL's, out to the camera's range: a cluster seen from afar through a doorway
     // has FUEL's rings all in the unknown room around it, and the known space it can be seen from
-    // is farther. Without them the tour ran dry with such clusters left and the run ended DONE
-    // (env2, semantic-fuel on the latency tour, seed 1, process set: 53 % of T at 25.8 s).
+    // is farther.
     const double step = (fuel_.view_radius_max - fuel_.view_radius_min) / (fuel_.view_radius_steps - 1);
     radii.clear();
     if (step > 0)

@@ -508,7 +508,7 @@ TEST(Viewpoints, AClusterSeenThroughADoorwayFromAfarGetsAViewOnTheFarRingsAndOnl
   fill_m(g, {4.0, 0.0, 0.0}, {4.1, 4.0, 2.5}, VoxelState::kOccupied);
   fill_m(g, {4.0, 1.5, 0.0}, {4.1, 2.5, 2.5}, VoxelState::kFree);
   fill_m(g, {4.1, 1.8, 0.0}, {8.5, 2.2, 2.5}, VoxelState::kFree);
-  PlannerConfig c = test_config("fuel");
+  const PlannerConfig c = test_config("fuel");
   FrontierTracker tracker;
   tracker.reset(g);
   FrontierClusters fc(0.1, c.fuel.min_cluster_voxels, c.fuel.split_radius);
@@ -517,13 +517,11 @@ TEST(Viewpoints, AClusterSeenThroughADoorwayFromAfarGetsAViewOnTheFarRingsAndOnl
   CollisionChecker checker(c.collision);
   checker.set_grid(&g);
   GainEvaluator gains(c.gain);
-  PlannerConfig off = c;
-  off.fuel.far_rings = false;
-  ViewpointSampler with_far(c, checker, gains), without(off, checker, gains);
+  ViewpointSampler sampler(c, checker, gains);
   int far_only = 0, near_same = 0;
   for (const auto& [id, cl] : fc.clusters()) {
-    const std::vector<Viewpoint> a = with_far.sample(g, cl, nullptr, 0.0);
-    const std::vector<Viewpoint> b = without.sample(g, cl, nullptr, 0.0);
+    const std::vector<Viewpoint> a = sampler.sample(g, cl, nullptr, 0.0, true);
+    const std::vector<Viewpoint> b = sampler.sample(g, cl, nullptr, 0.0, false);
     if (!b.empty()) {
       // A cluster with a view on FUEL's rings keeps exactly those views.
       ASSERT_EQ(a.size(), b.size());
@@ -685,6 +683,45 @@ void skip_places(Strategy& strategy, const Eigen::Vector3d& lo, const Eigen::Vec
         skip.position = Eigen::Vector3d(x, y, z);
         strategy.reject_goal(skip, until);
       }
+}
+
+// A closed room (x 0-4, y 0-4, z 0-2.5) known, a doorway in its wall at x = 4 (y 1.5-2.5), and
+// beyond it only a slot 0.4 m wide seen through the doorway, walled to x = walled and open to
+// x = slot_end: the slot's open end is all there is to explore.
+void reveal_room_and_slot(PlanScene& s, double walled, double slot_end) {
+  fill_m(s.grid, {-0.1, -0.1, -0.1}, {4.1, 4.1, 2.6}, VoxelState::kOccupied);
+  fill_m(s.grid, {4.1, 1.4, -0.1}, {walled, 2.6, 2.6}, VoxelState::kOccupied);
+  fill_m(s.grid, {0.0, 0.0, 0.0}, {4.0, 4.0, 2.5}, VoxelState::kFree);
+  fill_m(s.grid, {4.0, 1.5, 0.0}, {4.1, 2.5, 2.5}, VoxelState::kFree);
+  fill_m(s.grid, {4.1, 1.8, 0.0}, {slot_end, 2.2, 2.5}, VoxelState::kFree);
+  s.frontiers.reset(s.grid);
+}
+
+// Clusters seen through a doorway from afar, with no viewpoint on FUEL's rings: with the far
+// rings the tour has a goal in the room it sees them from; without, the plan finds no cluster
+// with a viewpoint (at the start, a turn in place; later, the end). A slot open near enough for
+// FUEL's rings gives the same goal either way.
+TEST(Fuel, FarRingsAreTheLastResortBeforeTheTourRunsDry) {
+  const auto first_plan = [](double slot_end, bool far) {
+    PlanScene s("fuel");
+    s.config.fuel.far_rings = far;
+    reveal_room_and_slot(s, slot_end - 2.0, slot_end);
+    FuelStrategy fuel(s.config);
+    PlanContext ctx = s.context({1.5, 2.0, 1.2});
+    ctx.need_goal = true;
+    return fuel.plan(ctx);
+  };
+  const PlanOutcome far = first_plan(8.5, true), none = first_plan(8.5, false);
+  ASSERT_TRUE(far.goal.valid) << far.reason;
+  EXPECT_LT(far.goal.position.x(), 4.0) << "seen from the known room";
+  EXPECT_NE(far.goal.waypoints.size(), 1u) << "a flight, not a turn in place";
+  EXPECT_NE(none.reason.find("turning in place at the start: no frontier cluster"), std::string::npos)
+      << none.reason;
+  const PlanOutcome near_far = first_plan(6.0, true), near_none = first_plan(6.0, false);
+  ASSERT_TRUE(near_far.goal.valid) << near_far.reason;
+  ASSERT_TRUE(near_none.goal.valid) << near_none.reason;
+  EXPECT_EQ(near_far.goal.position, near_none.goal.position);
+  EXPECT_EQ(near_far.goal.yaw, near_none.goal.yaw);
 }
 
 // SyntheticWorld::two_rooms known up to 1.5 m into the second room (x 0-4 and 4.2-8.2, y 0-4).

@@ -38,9 +38,11 @@ class ViewpointSampler {
 
   // The cluster's viewpoints, best coverage first (ties: candidate order); empty when none sees
   // min_coverage voxels. The rings' directions start `phase` (0..1) of their spacing past -pi.
+  // With `far`, when no ring of FUEL's radii (nor at a half and a quarter of the least) has a
+  // viewpoint, rings farther out in the same steps to the camera's range are tried too.
   // Counts its ray steps into `counters`.
   std::vector<Viewpoint> sample(const map::StateGrid& grid, const FrontierClusters::Cluster& cluster,
-                                CycleCounters* counters, double phase = 0.0) const;
+                                CycleCounters* counters, double phase = 0.0, bool far = false) const;
   // The coverage and yaw from one position (tests; sample() uses it for every candidate).
   Viewpoint view_from(const map::StateGrid& grid, const std::vector<map::VoxelKey>& cells, double scale,
                       const Eigen::Vector3d& p, int64_t* ray_steps) const;
