@@ -385,9 +385,10 @@ struct FuelConfig {
   // m: candidates are at the cluster's mean height (clamped to sampling.z_min..z_max); when none
   // of them is a viewpoint, also this far above and below it.
   double view_height_step = 0.5;
-  // When the tour finds no cluster with a viewpoint, the clusters with none on the rings above
-  // (nor at a half and a quarter of the least radius) get rings farther out, in view_radius
-  // steps, to the camera's range, before the planner ends (not in FUEL).
+  // When the tour finds no cluster with a viewpoint, the clusters of major_cluster_voxels and more
+  // with none on the rings above (nor at a half and a quarter of the least radius) get rings
+  // farther out, in view_radius steps, to the camera's range, before the planner ends (not in
+  // FUEL).
   bool far_rings = true;
   // At most this many of a cluster's voxels (spread over it) are tested for visibility; a
   // candidate's coverage is the share of them it sees times the cluster's voxels (FUEL
