@@ -13,11 +13,7 @@ namespace semx::planner {
 using map::VoxelKey;
 
 AepStrategy::AepStrategy(const PlannerConfig& config)
-    : config_(config),
-      checker_(config.collision),
-      gains_(config.gain),
-      global_(config, false),
-      cache_(config.roadmap.max_edge_length) {}
+    : config_(config), gains_(config.gain), global_(config, false), cache_(config.roadmap.max_edge_length) {}
 
 void AepStrategy::reset() {
   global_.reset();
@@ -47,8 +43,8 @@ void AepStrategy::on_map_reset() {
 void AepStrategy::mark_cache_stale() {
   if (cache_reset_) {
     cache_.clear();
-  } else if (!changed_blocks_.empty() && checker_.grid()) {
-    const double res = checker_.grid()->resolution();
+  } else if (!changed_blocks_.empty() && checker().grid()) {
+    const double res = checker().grid()->resolution();
     const double block = map::kBlockSize * res;
     const double radius = config_.gain.max_range + 0.5 * block * std::sqrt(3.0) + res;
     for (const VoxelKey& b : changed_blocks_) {
@@ -83,9 +79,10 @@ void AepStrategy::gain_of(PlanContext& ctx, TreeNode& n) {
 }
 
 PlanOutcome AepStrategy::plan(PlanContext& ctx) {
-  checker_.set_grid(ctx.grid);
+  CollisionChecker& checker = this->checker();
+  checker.set_grid(ctx.grid);
   gains_.set_ignored(ctx.unobservable);
-  checker_.reset_counters();
+  checker.reset_counters();
   mark_cache_stale();
   // The global graph: prune, and add the vehicle's pose (kept as a backbone node later).
   global_.process_map_changes(ctx);
@@ -110,7 +107,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
   auto edge_ok = [&](int from, const Eigen::Vector3d& p) {
     ++ctx.counters->edges_checked;
     const Eigen::Vector3d& q = tree_[static_cast<size_t>(from)].position;
-    return from == 0 ? checker_.root_edge_free(q, p) : checker_.edge_free(q, p);
+    return from == 0 ? checker.root_edge_free(q, p) : checker.edge_free(q, p);
   };
   for (int i = 0; i < attempts && more(); ++i) {
     ++ctx.counters->samples_drawn;
@@ -126,7 +123,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
     const double len = (q - from).norm();
     if (len < 1e-6) continue;
     Eigen::Vector3d p = from + std::min(len, a.step) / len * (q - from);
-    const bool node_ok = checker_.centre(p);  // moved off a wall when too close (as DEP's draws)
+    const bool node_ok = checker.centre(p);  // moved off a wall when too close (as DEP's draws)
     ctx.counters->sample_ms += sw.ms();
     if (!node_ok) continue;
 
@@ -166,7 +163,7 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
       if (j == 0 || j == parent) continue;
       TreeNode& m = tree_[static_cast<size_t>(j)];
       const double c2 = cost + (m.position - p).norm();
-      if (c2 + 1e-9 < m.cost && (++ctx.counters->edges_checked, checker_.edge_free(p, m.position))) {
+      if (c2 + 1e-9 < m.cost && (++ctx.counters->edges_checked, checker.edge_free(p, m.position))) {
         const double delta = c2 - m.cost;
         m.parent = id;
         // Costs of the subtree below j drop by the same amount.
@@ -243,9 +240,8 @@ PlanOutcome AepStrategy::plan(PlanContext& ctx) {
       out.reason = r.str();
     }
   }
-  ctx.counters->box_checks += checker_.box_checks() + global_.checker().box_checks();
-  checker_.reset_counters();
-  global_.checker().reset_counters();
+  ctx.counters->box_checks += checker.box_checks();
+  checker.reset_counters();
   return out;
 }
 

@@ -48,9 +48,12 @@ class AepStrategy : public Strategy {
  private:
   void gain_of(PlanContext& ctx, TreeNode& n);
   void mark_cache_stale();
+  // The tree's checks use the fallback graph's checker: its ESDF cache is kept across map updates
+  // (DepStrategy::on_map_changes passes them on), where a checker of the tree's own refilled every
+  // chunk after each update, a third of them ones the graph's checker had filled as well.
+  CollisionChecker& checker() { return global_.checker(); }
 
   PlannerConfig config_;
-  CollisionChecker checker_;
   GainEvaluator gains_;
   DepStrategy global_;  // the fallback graph (no sampling of its own)
   Roadmap cache_;       // cached gains at positions (no edges)
