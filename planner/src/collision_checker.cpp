@@ -206,6 +206,14 @@ int CollisionChecker::reach_for(double cap, double res) {
 
 void CollisionChecker::note_changes(const std::vector<map::VoxelChange>& changes) const {
   if (!cache_grid_ || changes.empty()) return;
+  if (cache_grid_->changes() - cache_stamp_[0] > changes.size()) {
+    // The grid made transitions that are not in `changes` (a map replaced whole, or a delta
+    // this checker was not told of): nothing tells which values still hold, so none is kept.
+    for (auto& c : centre_cache_) c.clear();
+    last_chunk_ = {};
+    cache_stamp_ = stamp_of(*cache_grid_);
+    return;
+  }
   // A change at v alters the values of centres within `reach` of it: the chunks that hold any
   // voxel of v ± reach. Per changed chunk, the bounding box of its changes grown by reach (3 or 4
   // chunks per axis, not the 5 of a chunk's whole neighbourhood).

@@ -52,6 +52,9 @@ void ExplorationPlanner::set_map(const map::StateGrid* grid) {
 void ExplorationPlanner::on_map_changes(const std::vector<map::VoxelChange>& changes) {
   if (!grid_) return;
   frontiers_.update(*grid_, changes);
+  // The path check's ESDF cache keeps what the changes leave true (without, it was refilled
+  // whole after every update).
+  checker_.note_changes(changes);
   strategy_->on_map_changes(changes);
 }
 

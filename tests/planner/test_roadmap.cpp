@@ -124,7 +124,8 @@ TEST(Collision, NodesKeepTheClearanceFromOccupiedAndUnknown) {
 
 // The cached ESDF (chunks filled by one distance transform each) against a brute-force nearest
 // obstacle over a cluttered map with unknown voxels and blocks never allocated, for both unknown
-// rules, and again after local changes reported through note_changes.
+// rules, and again after local changes reported through note_changes, also when half of them
+// are left out of the report (a map replaced whole, a delta not passed on).
 TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
   map::StateGrid g(0.1);
   std::mt19937 rng(3);
@@ -190,6 +191,7 @@ TEST(Collision, CachedEsdfIsTheBruteForceDistance) {
       g.set_state(k, after);
       changes.push_back({k, after, round > 0 ? std::optional<VoxelState>(before) : std::nullopt});
     }
+    if (round == 2) changes.resize(changes.size() / 2);
     c.note_changes(changes);
   }
 }

@@ -81,7 +81,8 @@ class CollisionChecker {
   bool centre(Eigen::Vector3d& p, int iterations = 3, double max_step = 0.3, bool passage = false) const;
 
   // The grid changed at these voxels and nowhere else since the checker last looked: cached ESDF
-  // values near them are dropped, the rest kept (any other change drops the whole cache).
+  // values near them are dropped, the rest kept. When the grid made more transitions than there
+  // are changes (it was replaced, or a delta was not passed on), the whole cache is dropped.
   void note_changes(const std::vector<map::VoxelChange>& changes) const;
 
   // Centre values are cached in chunks of kChunkSize^3 voxels, each filled at once.

@@ -31,7 +31,11 @@ class NbvStrategy : public Strategy {
  public:
   explicit NbvStrategy(const PlannerConfig& config);
 
-  void on_map_changes(const std::vector<map::VoxelChange>&) override {}
+  // The checker's ESDF cache keeps what the changes leave true (without, it was refilled whole
+  // after every update).
+  void on_map_changes(const std::vector<map::VoxelChange>& changes) override {
+    checker_.note_changes(changes);
+  }
   void on_map_reset() override {}
   void on_gain_invalidated(const std::vector<map::VoxelKey>&) override {}
   PlanOutcome plan(PlanContext& ctx) override;
