@@ -400,8 +400,9 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       // the cluster from, at the edge of its depth range, and seeing it again maps little: on
       // every plan they cost the 24-world set 9 % of Time_r (set 24: 168 -> 348 s). Without them
       // semantic-fuel on the latency tour ended DONE at 53 % in env2's process set (seed 1),
-      // with 8 clusters seen through the doorway and none with a viewpoint. The small clusters
-      // left at the end made 10 of the 24 runs longer (Time_f up to +38 s); FUEL's size, 2.
+      // with 8 clusters seen through the doorway and none with a viewpoint. For clusters of any
+      // size, the small ones left at the end made 10 of the 24 runs longer (Time_f up to +38 s);
+      // with FUEL's size as the least, 2. A cluster keeps its far views until it changes.
       far_tried = true;
       int64_t got = 0;
       for (auto& [id, cs] : state_) {

@@ -49,8 +49,8 @@ class AepStrategy : public Strategy {
   void gain_of(PlanContext& ctx, TreeNode& n);
   void mark_cache_stale();
   // The tree's checks use the fallback graph's checker: its ESDF cache is kept across map updates
-  // (DepStrategy::on_map_changes passes them on), where a checker of the tree's own refilled every
-  // chunk after each update, a third of them ones the graph's checker had filled as well.
+  // (DepStrategy::on_map_changes passes them on). A checker of the tree's own was told of none,
+  // so it refilled every chunk it read after each update.
   CollisionChecker& checker() { return global_.checker(); }
 
   PlannerConfig config_;
