@@ -469,11 +469,12 @@ bool DepStrategy::nothing_to_do(PlanContext& ctx, int64_t id, double yaw) const 
          core::yaw_distance(ctx.pose.yaw, yaw) < config_.loop.yaw_tolerance;
 }
 
-DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t id) const {
+DepStrategy::FlownPath DepStrategy::flown_path(const PlanContext& ctx, int64_t id,
+                                               std::optional<double> yaw) const {
   FlownPath f;
   const std::vector<int64_t> path = Roadmap::path_to(search_, id);
   for (int64_t p : path) f.waypoints.push_back(graph_.node(p).position);
-  f.yaws = interpolate_yaws(f.waypoints, ctx.pose.yaw, yaw_[static_cast<size_t>(id)]);
+  f.yaws = interpolate_yaws(f.waypoints, ctx.pose.yaw, yaw ? *yaw : yaw_[static_cast<size_t>(id)]);
   f.held = hold_heading_through_doorways(path, f.waypoints, f.yaws);
   return f;
 }
@@ -681,7 +682,7 @@ Goal DepStrategy::cut_look_goal(PlanContext& ctx) const {
   // The unreachable parts worth reaching: each part of the roadmap the vehicle cannot reach
   // that holds at least cut_look_nodes informative nodes. A node or two cut off is a pocket
   // behind furniture (on a cabinet, under a table), which no look opens: in the 396 m² world with
-  // noise, seven of nine looks went to such parts, of one informative node each.
+  // noise, most looks went to such parts, of one informative node each, before this rule.
   const double min_gain = std::max(config_.gain.min_gain, ctx.min_gain);
   auto informative = [&](const RoadmapNode& n) { return n.gain.valid && n.gain.gain >= min_gain; };
   std::vector<char> wanted(graph_.slots().size(), 0), seen(graph_.slots().size(), 0);
@@ -735,10 +736,9 @@ Goal DepStrategy::cut_look_goal(PlanContext& ctx) const {
   g.yaw = std::atan2(d.y(), d.x());
   const size_t i = static_cast<size_t>(from);
   g.cost = travel_time(search_.distance[i], ctx.pose.yaw, g.yaw, config_.cost);
-  const std::vector<int64_t> path = Roadmap::path_to(search_, from);
-  for (int64_t p : path) g.waypoints.push_back(graph_.node(p).position);
-  g.yaws = interpolate_yaws(g.waypoints, ctx.pose.yaw, g.yaw);
-  hold_heading_through_doorways(path, g.waypoints, g.yaws);
+  FlownPath f = flown_path(ctx, from, g.yaw);
+  g.waypoints = std::move(f.waypoints);
+  g.yaws = std::move(f.yaws);
   return g;
 }
 

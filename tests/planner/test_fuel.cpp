@@ -447,14 +447,20 @@ map::StateGrid corridor() {
   return g;
 }
 
+// The grid's frontier clusters at 0.4 m and above (FUEL's ground filter), as the strategy makes them.
+FrontierClusters clusters_of(const map::StateGrid& g, const PlannerConfig& c) {
+  FrontierTracker tracker;
+  tracker.reset(g);
+  FrontierClusters fc(g.resolution(), c.fuel.min_cluster_voxels, c.fuel.split_radius);
+  const auto& all = tracker.voxels();
+  fc.rebuild({all.begin(), all.end()}, [&](const VoxelKey& k) { return tracker.contains(k) && k.z >= 4; });
+  return fc;
+}
+
 TEST(Viewpoints, FaceTheFrontierFromFreeSpaceWithTheClearance) {
   const map::StateGrid g = corridor();  // the frontier is the plane x = 6.0..6.1
   const PlannerConfig c = test_config("fuel");
-  FrontierTracker tracker;
-  tracker.reset(g);
-  FrontierClusters fc(0.1, c.fuel.min_cluster_voxels, c.fuel.split_radius);
-  const auto& all = tracker.voxels();
-  fc.rebuild({all.begin(), all.end()}, [&](const VoxelKey& k) { return tracker.contains(k) && k.z >= 4; });
+  const FrontierClusters fc = clusters_of(g, c);
   ASSERT_FALSE(fc.clusters().empty());
   CollisionChecker checker(c.collision);
   checker.set_grid(&g);
@@ -509,11 +515,7 @@ TEST(Viewpoints, AClusterSeenThroughADoorwayFromAfarGetsAViewOnTheFarRingsAndOnl
   fill_m(g, {4.0, 1.5, 0.0}, {4.1, 2.5, 2.5}, VoxelState::kFree);
   fill_m(g, {4.1, 1.8, 0.0}, {8.5, 2.2, 2.5}, VoxelState::kFree);
   const PlannerConfig c = test_config("fuel");
-  FrontierTracker tracker;
-  tracker.reset(g);
-  FrontierClusters fc(0.1, c.fuel.min_cluster_voxels, c.fuel.split_radius);
-  const auto& all = tracker.voxels();
-  fc.rebuild({all.begin(), all.end()}, [&](const VoxelKey& k) { return tracker.contains(k) && k.z >= 4; });
+  const FrontierClusters fc = clusters_of(g, c);
   CollisionChecker checker(c.collision);
   checker.set_grid(&g);
   GainEvaluator gains(c.gain);

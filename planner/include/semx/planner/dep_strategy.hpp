@@ -23,6 +23,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -76,7 +77,8 @@ class DepStrategy : public Strategy {
     std::vector<double> yaws;
     bool held = false;
   };
-  FlownPath flown_path(const PlanContext& ctx, int64_t id) const;
+  // Facing `yaw` at the end, or the node's own yaw without it.
+  FlownPath flown_path(const PlanContext& ctx, int64_t id, std::optional<double> yaw = std::nullopt) const;
   // Sets the yaws at each passage node of a path and at the waypoints either side of it to the
   // direction of travel through it; true when it held any.
   bool hold_heading_through_doorways(const std::vector<int64_t>& path, const std::vector<Eigen::Vector3d>& w,
