@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <queue>
 #include <unordered_map>
-#include <unordered_set>
 #include <utility>
 
 namespace semx::planner {
@@ -64,9 +64,17 @@ const std::vector<Step>& steps() {
   return s;
 }
 
-uint64_t pack(const VoxelKey& k) {
-  return map::pack_block(k);  // 21 bits per axis: any lattice coordinate of a valid key
+// The searches' queue holds (cost, index) as one word: the bits of a float >= 0 order as the
+// float does, so one integer comparison orders as the pair did (ties to the lower index), at a
+// fraction of the pair's compare in the heap's sifts, the most of a search's own time.
+// Lattice indices fit 32 bits as the parents (int32_t) do.
+uint64_t queue_item(float cost, int64_t index) {
+  uint32_t bits = 0;
+  std::memcpy(&bits, &cost, sizeof bits);
+  return uint64_t{bits} << 32 | static_cast<uint32_t>(index);
 }
+int64_t queue_index(uint64_t item) { return static_cast<int64_t>(item & 0xffffffffu); }
+using Queue = std::priority_queue<uint64_t, std::vector<uint64_t>, std::greater<uint64_t>>;
 
 }  // namespace
 
@@ -288,20 +296,19 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
   const bool astar = goal_index >= 0;
   int64_t offset[27];
   for (const Step& st : steps()) offset[st.k] = st.d.x + static_cast<int64_t>(l.nx) * (st.d.y + static_cast<int64_t>(l.ny) * st.d.z);
-  using Item = std::pair<float, int64_t>;  // (g + h, index); ties go to the lower index
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
-  auto h = [&](int64_t i) { return astar ? static_cast<float>((point(l, l.coords(i)) - goal).norm()) : 0.0f; };
+  Queue open;  // g + h and the index; ties go to the lower index
+  auto h = [&](const VoxelKey& v) { return astar ? static_cast<float>((point(l, v) - goal).norm()) : 0.0f; };
   for (const auto& [i, g0] : seeds) {
     const float g = static_cast<float>(g0);
     if (l.stamp[static_cast<size_t>(i)] == l.now && l.g[static_cast<size_t>(i)] <= g) continue;
     l.stamp[static_cast<size_t>(i)] = l.now;
     l.g[static_cast<size_t>(i)] = g;
     l.parent[static_cast<size_t>(i)] = -1;
-    open.emplace(g + h(i), i);
+    open.push(queue_item(g + h(l.coords(i)), i));
   }
   int64_t settled = 0;
   while (!open.empty() && settled < max_settled) {
-    const auto [f, i] = open.top();
+    const int64_t i = queue_index(open.top());
     open.pop();
     const size_t si = static_cast<size_t>(i);
     if (l.closed[si] == l.now) continue;
@@ -325,7 +332,9 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
     for (const Step& st : steps()) {
       const int64_t j = nb_index[st.k];
       const uint8_t pj = nb[st.k];
-      if (pj == kBlocked || l.closed[static_cast<size_t>(j)] == l.now || !allowed(j)) continue;
+      if (pj == kBlocked || l.closed[static_cast<size_t>(j)] == l.now) continue;
+      const VoxelKey cj = c + st.d;
+      if (!allowed(cj)) continue;
       bool cut = false;
       for (int a = 0; a < st.n_across && !cut; ++a) cut = nb[st.across[a]] == kBlocked;
       if (cut) continue;
@@ -337,7 +346,7 @@ int64_t GridSearch::search(Lattice& l, const std::vector<std::pair<int64_t, doub
       l.stamp[sj] = l.now;
       l.g[sj] = g;
       l.parent[sj] = static_cast<int32_t>(i);
-      open.emplace(g + h(j), j);
+      open.push(queue_item(g + h(cj), j));
     }
   }
   return settled;
@@ -406,8 +415,7 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
     std::fill(l.col_closed.begin(), l.col_closed.end(), 0);
     l.now = 1;
   }
-  using Item = std::pair<float, int64_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
+  Queue open;
   auto seed = [&](int64_t col) {
     const float g = static_cast<float>((centre(col) - source.head<2>()).norm());
     const size_t i = static_cast<size_t>(col);
@@ -415,7 +423,7 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
     l.col_stamp[i] = l.now;
     l.col_g[i] = g;
     l.col_parent[i] = -1;
-    open.emplace(g, col);
+    open.push(queue_item(g, col));
   };
   uint64_t sp = 0, sh = 0;
   heights(s, sp, sh);
@@ -433,7 +441,10 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
       }
   }
   // Each target is served by its column and the eight around it.
-  std::unordered_map<int64_t, std::vector<size_t>> serves;
+  // Per column the first of the targets it serves, chained through serve_next (-1 ends): read for
+  // every column settled, where a hash map's lookup was a tenth of the search.
+  std::vector<int32_t> serve_head(static_cast<size_t>(plane), -1);
+  std::vector<std::pair<int32_t, int32_t>> serve_next;  // (target, next)
   std::vector<std::vector<int64_t>> near(targets.size());
   for (size_t t = 0; t < targets.size(); ++t) {
     if (!targets[t].allFinite()) continue;
@@ -446,7 +457,8 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
         if (cx + dx < 0 || cy + dy < 0 || cx + dx >= l.nx || cy + dy >= l.ny) continue;
         const int64_t j = c + dx + static_cast<int64_t>(l.nx) * dy;
         near[t].push_back(j);
-        serves[j].push_back(t);
+        serve_next.emplace_back(static_cast<int32_t>(t), serve_head[static_cast<size_t>(j)]);
+        serve_head[static_cast<size_t>(j)] = static_cast<int32_t>(serve_next.size() - 1);
       }
   }
   std::vector<bool> touched(targets.size(), false);
@@ -454,17 +466,15 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
   for (size_t t = 0; t < targets.size(); ++t) left += near[t].empty() ? 0 : 1;
   static const int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1}, kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
   while (!open.empty() && r.settled < max_settled && left > 0) {
-    const auto [f, c] = open.top();
+    const int64_t c = queue_index(open.top());
     open.pop();
     const size_t ci = static_cast<size_t>(c);
     if (l.col_closed[ci] == l.now) continue;
     l.col_closed[ci] = l.now;
     ++r.settled;
-    const auto it = serves.find(c);
-    if (it != serves.end()) {
-      for (size_t t : it->second) {
-        if (!touched[t]) touched[t] = true, --left;
-      }
+    for (int32_t e = serve_head[ci]; e >= 0; e = serve_next[static_cast<size_t>(e)].second) {
+      const size_t t = static_cast<size_t>(serve_next[static_cast<size_t>(e)].first);
+      if (!touched[t]) touched[t] = true, --left;
     }
     uint64_t pc = 0, hc = 0;
     heights(c, pc, hc);
@@ -494,7 +504,7 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
       l.col_stamp[ni] = l.now;
       l.col_g[ni] = g;
       l.col_parent[ni] = static_cast<int32_t>(c);
-      open.emplace(g, n);
+      open.push(queue_item(g, n));
     }
   }
   // The columns ignore height: the climb between source and target is added to the horizontal
@@ -580,18 +590,30 @@ bool GridSearch::find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, c
     out = {a, b};
     return true;
   }
-  // The corridor: coarse columns within two of the guide's, at any height.
-  std::unordered_set<uint64_t> corridor;
+  // The corridor: coarse columns within two of the guide's, at any height. A dense mask over the
+  // guide's box, as it is asked about for every neighbour of every voxel settled.
   const int cs = coarse_.stride;
+  int cx0 = std::numeric_limits<int>::max(), cy0 = cx0, cx1 = std::numeric_limits<int>::min(), cy1 = cx1;
+  std::vector<VoxelKey> guide_cells;
+  guide_cells.reserve(guide.size());
   for (const Eigen::Vector3d& g : guide) {
     const VoxelKey c = lattice_of(coarse_, g);
-    for (int dy = -2; dy <= 2; ++dy)
-      for (int dx = -2; dx <= 2; ++dx) corridor.insert(pack(VoxelKey{c.x + dx, c.y + dy, 0}));
+    guide_cells.push_back(c);
+    cx0 = std::min(cx0, c.x - 2), cy0 = std::min(cy0, c.y - 2);
+    cx1 = std::max(cx1, c.x + 2), cy1 = std::max(cy1, c.y + 2);
   }
-  auto allowed = [&](int64_t j) {
-    if (corridor.empty()) return true;
-    const VoxelKey v = l.coords(j);
-    return corridor.count(pack(VoxelKey{floor_div(v.x, cs), floor_div(v.y, cs), 0})) != 0;
+  const int cw = guide.empty() ? 0 : cx1 - cx0 + 1, ch = guide.empty() ? 0 : cy1 - cy0 + 1;
+  std::vector<uint8_t> corridor(static_cast<size_t>(cw) * static_cast<size_t>(ch), 0);
+  for (const VoxelKey& c : guide_cells)
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx)
+        corridor[static_cast<size_t>(c.x + dx - cx0) +
+                 static_cast<size_t>(cw) * static_cast<size_t>(c.y + dy - cy0)] = 1;
+  auto allowed = [&](const VoxelKey& v) {
+    if (guide.empty()) return true;
+    const int x = floor_div(v.x, cs) - cx0, y = floor_div(v.y, cs) - cy0;
+    return x >= 0 && y >= 0 && x < cw && y < ch &&
+           corridor[static_cast<size_t>(x) + static_cast<size_t>(cw) * static_cast<size_t>(y)] != 0;
   };
   bool reached = false;
   const int64_t n = search(l, {{s, 0.0}}, a, escape, goal, b, max_expansions, allowed, [&](int64_t i) {

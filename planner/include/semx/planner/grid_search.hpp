@@ -112,7 +112,7 @@ class GridSearch {
   uint8_t cls(Lattice& l, int64_t i);
   // Passability with the escape zone around `source` (when escape).
   uint8_t passable(Lattice& l, int64_t i, const Eigen::Vector3d& source, bool escape);
-  // Dijkstra (A* toward `goal` when goal_index >= 0) on l from the seeded cells; allowed(index)
+  // Dijkstra (A* toward `goal` when goal_index >= 0) on l from the seeded cells; allowed(coords)
   // restricts the cells; settle(index) returns true to stop. Returns the cells settled.
   template <class Allowed, class Settle>
   int64_t search(Lattice& l, const std::vector<std::pair<int64_t, double>>& seeds, const Eigen::Vector3d& source,
