@@ -324,7 +324,7 @@ void FuelStrategy::compute_rows(PlanContext& ctx) {
 
 std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, int64_t keep,
                                                              double* keep_cost, std::string* reason,
-                                                             int64_t* waiting) {
+                                                             int64_t* waiting, const Keeps& keeps) {
   const FuelConfig& f = config_.fuel;
   const CostConfig& cost = config_.cost;
   skipped_until_ = -1;
@@ -573,6 +573,24 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     const double goal_distance =
         first.vehicle_distance[static_cast<size_t>(choices[0][static_cast<size_t>(pick)])];
 
+    Planned p;
+    p.minor_only = !any_major;
+    p.cluster = first.cluster;
+    p.site = layer_site[0];
+    p.tour_cost = tour.cost;
+    Goal& g = p.goal;
+    g.valid = true;
+    g.node = first.cluster + 1;  // node ids of the roadmap view: 0 is the vehicle
+    g.position = goal_view.position;
+    g.yaw = goal_view.yaw;
+    g.gain = goal_view.coverage;
+    g.cost = travel_time(goal_distance, vehicle_yaw_, goal_view.yaw, cost);
+    g.score = g.gain / g.cost;
+    // A plan that keeps the target flies the path already flown: its own search would be thrown
+    // away, and in the 600 m² world it was a search of 10-25 ms in a tenth of the cycles near the
+    // p95 (issue 33). Its view's reachability is asked when it is chosen to be flown.
+    if (keeps && keeps(p, keep_cost ? *keep_cost : kInf)) return p;
+
     // The path: A* over voxels along the coarse path, then anywhere.
     core::Stopwatch pw;
     std::vector<Eigen::Vector3d> waypoints;
@@ -600,19 +618,6 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       *reason = "no path to the tour's next viewpoint";
       continue;
     }
-    Planned p;
-    p.minor_only = !any_major;
-    p.cluster = first.cluster;
-    p.site = layer_site[0];
-    p.tour_cost = tour.cost;
-    Goal& g = p.goal;
-    g.valid = true;
-    g.node = first.cluster + 1;  // node ids of the roadmap view: 0 is the vehicle
-    g.position = goal_view.position;
-    g.yaw = goal_view.yaw;
-    g.gain = goal_view.coverage;
-    g.cost = travel_time(goal_distance, vehicle_yaw_, goal_view.yaw, cost);
-    g.score = g.gain / g.cost;
     // 9 m: under the controller's 10 m with room for its rounding (env3 with sensor noise: 57
     // paths of 11.7-11.9 m segments rejected in 2.5 s bursts, each goal skipped after).
     g.waypoints = split_long_segments(waypoints, 9.0);
@@ -700,24 +705,31 @@ PlanOutcome FuelStrategy::plan(PlanContext& ctx) {
   }
   replan_reason_ = why;
   const int64_t keep = periodic ? successor(target_) : -1;
+  // Keep the target unless the new tour is clearly cheaper than the best one that keeps it.
+  const auto kept_by_period = [&](const Planned& q, double keep_cost) {
+    return periodic &&
+           !(q.cluster != keep && (!(keep_cost < kInf) || q.tour_cost < (1.0 - f.switch_margin) * keep_cost));
+  };
+  const auto same_view = [&](const Planned& q) {
+    return !ctx.need_goal && target_.valid && q.cluster == target_.cluster &&
+           (q.goal.position - target_.goal.position).norm() < kSameView &&
+           std::abs(core::wrap_angle(q.goal.yaw - target_.goal.yaw)) < kSameView;
+  };
   double keep_cost = kInf;
   std::string reason;
   int64_t waiting = 0;
-  const std::optional<Planned> p = plan_tour(ctx, keep, periodic ? &keep_cost : nullptr, &reason, &waiting);
+  const std::optional<Planned> p =
+      plan_tour(ctx, keep, periodic ? &keep_cost : nullptr, &reason, &waiting,
+                [&](const Planned& q, double c) { return kept_by_period(q, c) || same_view(q); });
   if (periodic) {
     target_.planned_utime = ctx.pose.utime;
-    // Keep the target unless the new tour is clearly cheaper than the best one that keeps it.
-    const bool better = p && p->cluster != keep &&
-                        (!(keep_cost < kInf) || p->tour_cost < (1.0 - f.switch_margin) * keep_cost);
-    if (!better) {
+    if (!p || kept_by_period(*p, keep_cost)) {
       replan_reason_ = "periodic: kept the target";
       out.goal = target_.goal;
       return finish();
     }
   }
-  if (p && !ctx.need_goal && target_.valid && p->cluster == target_.cluster &&
-      (p->goal.position - target_.goal.position).norm() < kSameView &&
-      std::abs(core::wrap_angle(p->goal.yaw - target_.goal.yaw)) < kSameView) {
+  if (p && same_view(*p)) {
     // The same view chosen again: the path being flown stays. A target whose cluster still
     // counted as covered was replanned every cycle, and each new path restarted the
     // controller's trajectory: env3's process set crawled at 0.8 m/s for 55 s (one goal of gain

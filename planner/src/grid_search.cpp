@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <queue>
 #include <unordered_map>
 #include <utility>
+
+#include "semx/core/queue_key.hpp"
+#include "semx/core/radix_heap.hpp"
 
 namespace semx::planner {
 
@@ -64,16 +66,11 @@ const std::vector<Step>& steps() {
   return s;
 }
 
-// The searches' queue holds (cost, index) as one word: the bits of a float >= 0 order as the
-// float does, so one integer comparison orders as the pair did (ties to the lower index), at a
-// fraction of the pair's compare in the heap's sifts, the most of a search's own time.
-// Lattice indices fit 32 bits as the parents (int32_t) do.
-uint64_t queue_item(float cost, int64_t index) {
-  uint32_t bits = 0;
-  std::memcpy(&bits, &cost, sizeof bits);
-  return uint64_t{bits} << 32 | static_cast<uint32_t>(index);
-}
-int64_t queue_index(uint64_t item) { return static_cast<int64_t>(item & 0xffffffffu); }
+// A* takes (cost, index) as one word (core/queue_key.hpp): one compare in the heap's sifts where
+// the pair took two, the most of a search's own time. Lattice indices fit 32 bits as the parents
+// (int32_t) do.
+uint64_t queue_item(float cost, int64_t index) { return core::queue_key(cost, static_cast<uint32_t>(index)); }
+int64_t queue_index(uint64_t item) { return core::queue_key_index(item); }
 using Queue = std::priority_queue<uint64_t, std::vector<uint64_t>, std::greater<uint64_t>>;
 
 }  // namespace
@@ -415,7 +412,10 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
     std::fill(l.col_closed.begin(), l.col_closed.end(), 0);
     l.now = 1;
   }
-  Queue open;
+  // Every step costs > 0, so no entry pushed is below the one popped: a radix heap pops in the
+  // binary heap's order (ties by column) with each entry moved once or twice instead of ~log n.
+  core::RadixHeap& open = column_queue_;
+  open.clear();
   auto seed = [&](int64_t col) {
     const float g = static_cast<float>((centre(col) - source.head<2>()).norm());
     const size_t i = static_cast<size_t>(col);
@@ -466,8 +466,7 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
   for (size_t t = 0; t < targets.size(); ++t) left += near[t].empty() ? 0 : 1;
   static const int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1}, kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
   while (!open.empty() && r.settled < max_settled && left > 0) {
-    const int64_t c = queue_index(open.top());
-    open.pop();
+    const int64_t c = queue_index(open.pop());
     const size_t ci = static_cast<size_t>(c);
     if (l.col_closed[ci] == l.now) continue;
     l.col_closed[ci] = l.now;

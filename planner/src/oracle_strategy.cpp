@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -11,6 +10,7 @@
 #include <unordered_set>
 
 #include "semx/core/angles.hpp"
+#include "semx/core/queue_key.hpp"
 #include "semx/core/radix_heap.hpp"
 #include "semx/core/stopwatch.hpp"
 #include "semx/planner/collision_checker.hpp"
@@ -369,9 +369,7 @@ void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<f
       heap.emplace(key, cell);
       return;
     }
-    uint32_t bits;
-    std::memcpy(&bits, &key, sizeof bits);
-    radix.push(static_cast<uint64_t>(bits) << 32 | static_cast<uint32_t>(cell));
+    radix.push(core::queue_key(key, static_cast<uint32_t>(cell)));
   };
   auto pop = [&]() -> Entry {
     if (!monotone) {
@@ -380,10 +378,7 @@ void OracleStrategy::Model::search(int64_t source, int64_t target, std::vector<f
       return e;
     }
     const uint64_t k = radix.pop();
-    const uint32_t bits = static_cast<uint32_t>(k >> 32);
-    float key;
-    std::memcpy(&key, &bits, sizeof key);
-    return {key, static_cast<int32_t>(static_cast<uint32_t>(k))};
+    return {core::queue_key_cost(k), static_cast<int32_t>(core::queue_key_index(k))};
   };
   cost[static_cast<size_t>(source)] = 0.0f;
   length[static_cast<size_t>(source)] = 0.0f;

@@ -34,6 +34,7 @@
 // what is around the start gives them one.
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -133,8 +134,11 @@ class FuelStrategy : public Strategy {
   // The last cycle of the bans on p (-1 when none is in force).
   int64_t ban_end(const Eigen::Vector3d& p, int64_t cycle) const;
   // Steps 3-6; `keep` (a cluster id or -1): also the cost of the best tour visiting it first.
+  // A plan that `keeps` (given the plan and that cost) says only confirms the target being flown
+  // is returned without its path: the search to the view is not made.
+  using Keeps = std::function<bool(const Planned&, double keep_cost)>;
   std::optional<Planned> plan_tour(PlanContext& ctx, int64_t keep, double* keep_cost, std::string* reason,
-                                   int64_t* waiting);
+                                   int64_t* waiting, const Keeps& keeps);
   void compute_rows(PlanContext& ctx);
   double site_distance(int a, int b) const;  // representative to representative, m
   double view_distance(int a, int va, int b, int vb) const;

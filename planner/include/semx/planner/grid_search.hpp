@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semx/core/radix_heap.hpp"
 #include "semx/core/zero_array.hpp"
 #include "semx/map/map_delta.hpp"
 #include "semx/map/state_grid.hpp"
@@ -132,6 +133,7 @@ class GridSearch {
   // lowered the ESDF (a voxel that stopped being free, or whose previous state is not known).
   std::map<map::VoxelKey, bool> dirty_coarse_, dirty_fine_;
   std::unordered_map<int64_t, uint8_t> escape_cache_;  // this search's escape-zone answers
+  core::RadixHeap column_queue_;                       // distances()' queue, its memory kept
   // The kept tree: its source, and the coarse lattice's g and parent when it was searched.
   bool tree_valid_ = false;
   Eigen::Vector3d tree_source_ = Eigen::Vector3d::Zero();
