@@ -598,9 +598,11 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     const std::vector<Eigen::Vector3d> guide = search_.tree_path(goal_view.position);
     bool found = search_.find_path(vehicle_, goal_view.position, guide, kMaxPathVoxels, waypoints, &expanded);
     ctx.counters->search_settled += expanded;
+    ++ctx.counters->paths_searched;
     if (!found && !guide.empty()) {
       found = search_.find_path(vehicle_, goal_view.position, {}, kMaxDetourVoxels, waypoints, &expanded);
       ctx.counters->search_settled += expanded;
+      ++ctx.counters->paths_searched;
     }
     ctx.counters->connect_ms += pw.ms();
     if (!found) {

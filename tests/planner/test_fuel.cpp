@@ -734,7 +734,8 @@ void reveal_first_room(PlanScene& s) {
 
 // A target that counts as covered while its cluster stays (its voxels found unobservable, which
 // changes no cluster) is planned again at once; when the plan chooses the same view, the goal
-// being flown stays (goal_score answers), instead of a new path to the same place every cycle.
+// being flown stays (goal_score answers), instead of a new path to the same place every cycle,
+// and no path is searched for it (the search's result would be thrown away).
 TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
   PlanScene s("fuel");
   reveal_first_room(s);
@@ -743,6 +744,8 @@ TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
   ctx.need_goal = true;
   const PlanOutcome first = fuel.plan(ctx);
   ASSERT_TRUE(first.goal.valid) << first.reason;
+  EXPECT_GE(s.counters.paths_searched, 1) << "a goal to fly: its path searched";
+  s.counters = CycleCounters();
   ASSERT_FALSE(fuel.tour().empty());
   const FrontierClusters::Cluster* target = fuel.clusters().find(fuel.tour().front());
   ASSERT_NE(target, nullptr);
@@ -756,6 +759,8 @@ TEST(Fuel, ReplanningTheSameViewKeepsTheGoalBeingFlown) {
   EXPECT_EQ(again.goal.position, first.goal.position);
   const std::optional<double> score = fuel.goal_score(next, first.goal);
   EXPECT_TRUE(score.has_value()) << "a replan that chose the same view must not read as a switch";
+  EXPECT_EQ(s.counters.paths_searched, 0) << "the path being flown stays: none searched";
+  EXPECT_GT(s.counters.search_settled, 0) << "the tour was planned again";
 }
 
 // Once only small clusters are left, a place given up twice before it was reached is flown until

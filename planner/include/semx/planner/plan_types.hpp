@@ -40,6 +40,7 @@ struct CycleCounters {
   int64_t rays = 0;
   int64_t ray_steps = 0;
   int64_t search_settled = 0;
+  int64_t paths_searched = 0;  // FUEL's path searches to a view (A*, the detour counted apart)
   int64_t nodes_pruned = 0;
   int64_t edges_pruned = 0;
   double sample_ms = 0, connect_ms = 0, gain_ms = 0, search_ms = 0, total_ms = 0;  // wall time
