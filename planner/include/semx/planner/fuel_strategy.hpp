@@ -134,8 +134,8 @@ class FuelStrategy : public Strategy {
   // The last cycle of the bans on p (-1 when none is in force).
   int64_t ban_end(const Eigen::Vector3d& p, int64_t cycle) const;
   // Steps 3-6; `keep` (a cluster id or -1): also the cost of the best tour visiting it first.
-  // A plan that `keeps` (given the plan and that cost) says only confirms the target being flown
-  // is returned without its path: the search to the view is not made.
+  // When `keeps` (given the plan and that cost) says a plan only confirms the target being flown,
+  // the plan comes without its path: the search to the view is not made.
   using Keeps = std::function<bool(const Planned&, double keep_cost)>;
   std::optional<Planned> plan_tour(PlanContext& ctx, int64_t keep, double* keep_cost, std::string* reason,
                                    int64_t* waiting, const Keeps& keeps);
