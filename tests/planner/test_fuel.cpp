@@ -390,6 +390,28 @@ TEST(GridSearch, ChangesNearACellAreSeenByTheNextSearch) {
   EXPECT_FALSE(s.find_path(a, b, {}, 1000000, path));
 }
 
+// A view in a closed pocket (a free cube walled in, in the second room): a search without a guide
+// proves from the view's side that no path exists, having settled the pocket's few cells, not the
+// rooms' thousands. A view in the open part of that room is still reached, through the doorway.
+TEST(GridSearch, AViewInAPocketIsProvedUnreachableFromItsOwnSide) {
+  map::StateGrid g = two_known_rooms();
+  fill_m(g, {5.5, 0.5, 0.5}, {7.0, 2.0, 2.0}, VoxelState::kOccupied);
+  fill_m(g, {5.6, 0.6, 0.6}, {6.9, 1.9, 1.9}, VoxelState::kFree);
+  RoomsSearch f(std::move(g));
+  const Eigen::Vector3d a(1.5, 0.8, 1.2), in_pocket(6.25, 1.25, 1.25);
+  std::vector<Eigen::Vector3d> path;
+  int64_t expanded = 0;
+  EXPECT_FALSE(f.s.find_path(a, in_pocket, {}, 1000000, path, &expanded));
+  EXPECT_GT(expanded, 0);
+  EXPECT_LT(expanded, 1000) << "the pocket's cells, not the rooms'";
+  const Eigen::Vector3d open(6.5, 3.2, 1.2);
+  ASSERT_TRUE(f.s.find_path(a, open, {}, 1000000, path, &expanded));
+  EXPECT_EQ(path.front(), a);
+  EXPECT_EQ(path.back(), open);
+  for (size_t i = 1; i < path.size(); ++i)
+    EXPECT_TRUE(f.checker.edge_free(path[i - 1], path[i])) << "segment " << i;
+}
+
 TEST(GridSearch, SpaceSeenFreeOrOccupiedGivesWhatAFreshSearchGives) {
   // The doorway starts unknown (no way through); then the camera sees it free and sees walls in
   // unknown space elsewhere. The cached search skips unknown -> occupied changes and keeps its

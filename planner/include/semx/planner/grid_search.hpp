@@ -113,12 +113,13 @@ class GridSearch {
   uint8_t cls(Lattice& l, int64_t i);
   // Passability with the escape zone around `source` (when escape).
   uint8_t passable(Lattice& l, int64_t i, const Eigen::Vector3d& source, bool escape);
-  // Dijkstra (A* toward `goal` when goal_index >= 0) on l from the seeded cells; allowed(coords)
-  // restricts the cells; settle(index) returns true to stop. Returns the cells settled.
+  // Dijkstra (A* toward `goal` when goal_index >= 0) on l from the seeded cells; goal_index and
+  // open_index (-1: none) count as passable whatever their class; allowed(coords) restricts the
+  // cells; settle(index) returns true to stop. Returns the cells settled.
   template <class Allowed, class Settle>
-  int64_t search(Lattice& l, const std::vector<std::pair<int64_t, double>>& seeds, const Eigen::Vector3d& source,
-                 bool escape, int64_t goal_index, const Eigen::Vector3d& goal, int64_t max_settled,
-                 Allowed&& allowed, Settle&& settle);
+  int64_t search(Lattice& l, const std::vector<std::pair<int64_t, double>>& seeds,
+                 const Eigen::Vector3d& source, bool escape, int64_t goal_index, int64_t open_index,
+                 const Eigen::Vector3d& goal, int64_t max_settled, Allowed&& allowed, Settle&& settle);
   // A coarse column's passable heights and those with passage clearance (cached).
   void column(int64_t col, uint64_t& pass, uint64_t& high);
   // The cells that stand for p: its own and its 26 neighbours.
