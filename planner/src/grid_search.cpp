@@ -26,8 +26,10 @@ constexpr int kDirtyBits = 2;
 // m: the body box grown by this keeps off every voxel along a segment, checked this often.
 constexpr double kBodyMargin = 0.02;
 constexpr double kBodyStep = 0.05;
-// A search without a guide first tries to prove the goal enclosed within this share of its budget.
-constexpr int64_t kPocketShare = 10;
+// A search without a guide first tries to prove the goal enclosed, settling at most this many
+// voxels (the pocket of semantic-fuel's failed search in g224 had 1424): a proof that does not run
+// dry is work thrown away, before every such search that finds its path.
+constexpr int64_t kPocketVoxels = 4000;
 
 int32_t floor_div(int32_t v, int32_t s) { return v >= 0 ? v / s : -((-v + s - 1) / s); }
 
@@ -626,7 +628,7 @@ bool GridSearch::find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, c
     // passable, so it reaches every cell a path from the start could pass: the answer is the
     // search's own, found sooner.
     bool met = false;
-    const int64_t budget = max_expansions / kPocketShare;
+    const int64_t budget = std::min(max_expansions, kPocketVoxels);
     const int64_t m = search(
         l, {{goal, 0.0}}, a, escape, s, goal, a, budget, [](const VoxelKey&) { return true; },
         [&](int64_t i) {
