@@ -38,7 +38,7 @@ uint32_t foreign_room_bytes() {
   std::ifstream in("/proc/sys/net/core/rmem_default");
   long bytes = 0;
   if (!(in >> bytes) || bytes < 65536) bytes = 212992;
-  return static_cast<uint32_t>(bytes / 2);
+  return static_cast<uint32_t>(bytes / 4);
 }
 
 std::vector<UdpSocketInfo> udp_sockets_on_port(const std::string& table, int port) {

@@ -101,8 +101,10 @@ bool UdpmSender::send_message(const std::string& channel, const uint8_t* data, s
   msg.msg_iov = iov;
   msg.msg_iovlen = 2;
   auto send = [&](std::size_t header, const uint8_t* part, std::size_t n) {
-    // A large datagram fills a small buffer: it goes once a reader outside the set has room.
-    if (listeners_ && header + n >= 8192) {
+    // Every datagram, not only a large one, goes once a reader outside the set has room: a
+    // 64 KB fragment taken into a queue that was not yet full can leave it full, and a small
+    // message sent next without a look (another node's status) was what the kernel dropped.
+    if (listeners_) {
       while (!listeners_->has_room(monotonic_s(), foreign_room_))
         std::this_thread::sleep_for(std::chrono::microseconds(200));
     }

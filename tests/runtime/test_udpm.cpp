@@ -4,18 +4,25 @@
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <signal.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <lcm/lcm-cpp.hpp>
 #include <semx/odometry_t.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "semx/runtime/bus_listeners.hpp"
 #include "semx/runtime/channels.hpp"
 #include "semx/runtime/lcm_url.hpp"
 #include "semx/runtime/node.hpp"
@@ -253,4 +260,58 @@ TEST(Udpm, ANodeCountsGarbageDatagramsAndKeepsWorking) {
   // the 2 GB claim reached the node and were counted (3 rounds); bytes that are not LCM's and a
   // header too short to hold a fragment number the filter itself dropped.
   EXPECT_EQ(node.counters().malformed, 6);
+}
+
+// A stock lcm-logger stopped by a signal holds its socket and reads nothing: once its queue is
+// past the room a sender leaves, even a small message waits for it. A status message that went
+// at once into a queue a camera frame had filled was what the kernel dropped at a stock reader.
+TEST(Udpm, ASmallMessageWaitsForAForeignReaderWithoutRoom) {
+  const char* stock = "/usr/bin/lcm-logger";
+  if (access(stock, X_OK) != 0) GTEST_SKIP() << "no " << stock;
+  const int p = port(7);
+  const std::string log = ::testing::TempDir() + "/semx_" + std::to_string(getpid()) + "_wait.lcmlog";
+  const std::string url = "--lcm-url=udpm://239.255.76.67:" + std::to_string(p) + "?ttl=0";
+  const pid_t logger = fork();
+  ASSERT_GE(logger, 0);
+  if (logger == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execl(stock, stock, url.c_str(), "--force", log.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  struct Reaper {  // a stopped logger must not outlive a failed assertion
+    pid_t pid;
+    std::string log;
+    ~Reaper() {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+      std::remove(log.c_str());
+    }
+  } reaper{logger, log};
+  auto read_proc = [] {
+    std::ifstream in("/proc/net/udp");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  auto queued = [&] {
+    uint32_t most = 0;
+    for (const auto& s : udp_sockets_on_port(read_proc(), p)) most = std::max(most, s.rx_queue);
+    return most;
+  };
+  for (int i = 0; i < 200 && udp_sockets_on_port(read_proc(), p).empty(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_FALSE(udp_sockets_on_port(read_proc(), p).empty()) << "lcm-logger never opened port " << p;
+  ASSERT_EQ(kill(logger, SIGSTOP), 0);
+
+  UdpmSender sender(endpoint(7), BusPace{}, /*foreign_hold_s=*/0.05);
+  const auto small = payload(100, 1);
+  ASSERT_TRUE(sender.publish("SMALL", small.data(), small.size()));
+  EXPECT_EQ(sender.waits(), 0) << "an empty queue has room";
+  const auto frame = payload(60000, 2);
+  for (int i = 0; i < 10 && queued() < foreign_room_bytes(); ++i)
+    ASSERT_TRUE(sender.publish("FRAME", frame.data(), frame.size()));
+  const uint32_t full = queued();
+  const int64_t before = sender.waits();
+  ASSERT_TRUE(sender.publish("SMALL", small.data(), small.size()));
+  EXPECT_GT(sender.waits(), before) << "the stopped reader's queue held " << full << " bytes of a room of "
+                                    << foreign_room_bytes();
 }

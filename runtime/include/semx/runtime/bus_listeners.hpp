@@ -30,9 +30,10 @@ std::vector<UdpSocketInfo> udp_sockets_on_port(const std::string& table, int por
 // variable when it is not a non-negative number.
 double foreign_hold_from_env();
 
-// What a foreign reader's socket may hold before a sender waits: half the kernel's default
-// receive buffer (net.core.rmem_default), so the next 64 KB fragment fits whatever it costs the
-// kernel.
+// What a foreign reader's socket may hold before a sender waits: a quarter of the kernel's
+// default receive buffer (net.core.rmem_default). The kernel's own count, against which it drops,
+// can be up to another quarter above what /proc/net/udp shows (memory the reader has taken and
+// not yet given back), and a 64 KB fragment (65 832 bytes to the kernel) must fit on top.
 uint32_t foreign_room_bytes();
 
 class BusListeners {

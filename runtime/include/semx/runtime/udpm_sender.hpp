@@ -28,8 +28,8 @@ class UdpmSender {
  public:
   // Throws std::runtime_error naming the endpoint and the failing call. `pace`: every datagram
   // waits for its turn (bus_pacer.hpp); by default what SEMX_BUS_PACE says, i.e. none.
-  // `foreign_hold_s` > 0: a datagram of 8 KB or more waits, up to that long, until every reader
-  // of the port outside the set (a stock lcm-logger) has room for it (bus_listeners.hpp).
+  // `foreign_hold_s` > 0: every datagram waits, up to that long, until every reader of the port
+  // outside the set (a stock lcm-logger) has room for it (bus_listeners.hpp).
   explicit UdpmSender(const UdpmEndpoint& endpoint, BusPace pace = bus_pace_from_env(),
                       double foreign_hold_s = foreign_hold_from_env());
   ~UdpmSender();
@@ -44,6 +44,10 @@ class UdpmSender {
   // under its first seqno (lcm_datagram.hpp), so readers join them with the fragments they hold;
   // a one-datagram one as a new message.
   bool publish_again(const std::string& channel, const uint8_t* data, std::size_t size, uint32_t seqno);
+
+  // How often a datagram found a reader outside the set without room and waited (one count per
+  // look, every 200 us); 0 with no such reader.
+  int64_t waits() const { return listeners_ ? listeners_->holds() : 0; }
 
   // The largest datagram this sender writes (liblcm reads up to 64 KiB).
   static constexpr std::size_t kMaxDatagram = 65000;
