@@ -33,7 +33,7 @@ double foreign_hold_from_env();
 // What a foreign reader's socket may hold before a sender waits: a quarter of the kernel's
 // default receive buffer (net.core.rmem_default). The kernel's own count, against which it drops,
 // can be up to another quarter above what /proc/net/udp shows (memory the reader has taken and
-// not yet given back), and a 64 KB fragment (65 832 bytes to the kernel) must fit on top.
+// not yet given back), and a 64 KB fragment (about 65 KB to the kernel) must fit on top.
 uint32_t foreign_room_bytes();
 
 class BusListeners {
