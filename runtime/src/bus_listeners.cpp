@@ -52,12 +52,16 @@ std::vector<UdpSocketInfo> udp_sockets_on_port(const std::string& table, int por
     std::string sl, local, remote, st, queues, tr, retr, uid, timeout;
     uint64_t inode = 0;
     if (!(f >> sl >> local >> remote >> st >> queues >> tr >> retr >> uid >> timeout >> inode)) continue;
+    std::string ref, pointer;
+    uint64_t drops = 0;
+    f >> ref >> pointer >> drops;  // drops, the last column, is absent on old kernels
     const auto colon = local.find(':');
     const auto qcolon = queues.find(':');
     if (colon == std::string::npos || qcolon == std::string::npos) continue;
     try {
       if (std::stoi(local.substr(colon + 1), nullptr, 16) != port) continue;
-      out.push_back({inode, static_cast<uint32_t>(std::stoul(queues.substr(qcolon + 1), nullptr, 16))});
+      out.push_back(
+          {inode, static_cast<uint32_t>(std::stoul(queues.substr(qcolon + 1), nullptr, 16)), drops});
     } catch (const std::exception&) {
     }
   }

@@ -19,13 +19,13 @@ const char* kHeader =
     "   sl  local_address rem_address   st tx_queue rx_queue tr tm->when retrnsmt   uid  timeout inode ref "
     "pointer drops\n";
 
-std::string udp_line(int port, unsigned rx_queue, unsigned long inode) {
+std::string udp_line(int port, unsigned rx_queue, unsigned long inode, unsigned long drops = 0) {
   char buf[256];
   std::snprintf(
       buf, sizeof buf,
       " 2243: 00000000:%04X 00000000:0000 07 00000000:%08X 00:00000000 00000000     0        0 %lu 2 "
-      "00000000fb493afc 0\n",
-      port, rx_queue, inode);
+      "00000000fb493afc %lu\n",
+      port, rx_queue, inode, drops);
   return buf;
 }
 
@@ -71,13 +71,15 @@ class FakeProc {
 }  // namespace
 
 TEST(BusListeners, ReadsTheSocketsOnAPort) {
-  const std::string table = std::string(kHeader) + udp_line(7667, 0x1234, 42) + udp_line(7668, 0, 43) +
+  const std::string table = std::string(kHeader) + udp_line(7667, 0x1234, 42, 17) + udp_line(7668, 0, 43, 5) +
                             udp_line(7667, 0, 44) + "garbage line\n";
   const auto s = udp_sockets_on_port(table, 7667);
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s[0].inode, 42u);
   EXPECT_EQ(s[0].rx_queue, 0x1234u);
+  EXPECT_EQ(s[0].drops, 17u);  // decimal, unlike the queues
   EXPECT_EQ(s[1].inode, 44u);
+  EXPECT_EQ(s[1].drops, 0u);
   EXPECT_TRUE(udp_sockets_on_port("", 7667).empty());
 }
 

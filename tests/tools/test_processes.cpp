@@ -11,12 +11,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -602,10 +600,10 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
          "    ends_set: true\n    start_delay: 1.0\n";
   std::filesystem::remove(stock);
   // A 2 MB receive buffer: what is tested here is that the set waits for the reader's threads
-  // (liblcm's queue of 30 loses without it). At the kernel's default buffer, 1 of about 90 runs
+  // (liblcm's queue of 30 loses without it). At the kernel's default buffer, one run of a series
   // on a loaded machine (kernel 6.18) still lost one small message that came in with a camera
-  // frame's fragments, although every sender waits for room; the room rule is tested on its own
-  // (Udpm.ASmallMessageWaitsForAForeignReaderWithoutRoom).
+  // frame's fragments, although every sender waits for room (docs/runtime.md); the room rule is
+  // tested on its own (Udpm.ASmallMessageWaitsForAForeignReaderWithoutRoom).
   Process logger(
       {stock_bin, "--lcm-url=udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0&recv_buf_size=2097152",
        stock},
@@ -636,19 +634,9 @@ TEST(Processes, StockLcmLoggerRecordsALockstepSetWhole) {
   }
   // What the kernel dropped at the port's sockets (by now only the stock logger's): tells a loss
   // in its socket buffer from one in liblcm's queue when this test fails.
-  long kernel_drops = 0;
-  {
-    std::istringstream table(read_file("/proc/net/udp"));
-    char hex_port[8];
-    std::snprintf(hex_port, sizeof hex_port, ":%04X", port);
-    std::string line;
-    while (std::getline(table, line)) {
-      std::istringstream fields(line);
-      std::vector<std::string> f{std::istream_iterator<std::string>(fields), {}};
-      if (f.size() > 12 && f[1].size() > 5 && f[1].compare(f[1].size() - 5, 5, hex_port) == 0)
-        kernel_drops += std::atol(f.back().c_str());
-    }
-  }
+  uint64_t kernel_drops = 0;
+  for (const auto& s : semx::runtime::udp_sockets_on_port(read_file("/proc/net/udp"), port))
+    kernel_drops += s.drops;
   logger.signal(SIGINT);
   ASSERT_EQ(logger.wait(10), 0) << read_file(temp_path("stock_logger.out"));
 

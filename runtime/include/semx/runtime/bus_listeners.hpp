@@ -20,6 +20,7 @@ namespace semx::runtime {
 struct UdpSocketInfo {
   uint64_t inode = 0;
   uint32_t rx_queue = 0;  // bytes not yet read
+  uint64_t drops = 0;     // datagrams the kernel dropped at this socket
 };
 
 // The UDP sockets bound to `port` listed in `table` (the text of /proc/net/udp).
