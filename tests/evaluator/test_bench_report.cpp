@@ -126,10 +126,11 @@ TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
                           "{\"time_s\": 30}, \"turn\": {\"time_s\": 10}, \"hover\": {\"time_s\": 0}, "
                           "\"end_game\": {\"time_s\": 20}}}\n";
   const std::string md = bench_markdown(load_bench_runs(root));
-  // Differences -10 and -10 s; relative -50 % and -25 %: mean -37.5, sd 17.68, t(1) 12.706.
+  // Differences -10 and -10 s; relative -50 % and -25 %: mean -37.5, sd 17.68, t(1) 12.706. As a
+  // share of dep's mean time (20 and 40 s: 30 s), -10 s is -33.3 % in both pairs.
   EXPECT_NE(
       md.find("| generated (2 worlds) | dep | Time_r | 2 | 2 / 0 / 0 | -10.00 | [-10.00, -10.00] | -37.5 | "
-              "[-196.3, 121.3] |"),
+              "[-196.3, 121.3] | -33.3 | [-33.3, -33.3] |"),
       std::string::npos)
       << md;
   EXPECT_NE(md.find("| generated-s1-a50-r1 | dep | 1 | 40.0 | 30.0 | 10.0 | 0.0 | 20.0 | 100.0 | 7.5 |"),
