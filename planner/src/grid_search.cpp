@@ -71,8 +71,7 @@ const std::vector<Step>& steps() {
 }
 
 // A* takes (cost, index) as one word (core/queue_key.hpp): one compare in the heap's sifts where
-// the pair took two, the most of a search's own time. Lattice indices fit 32 bits as the parents
-// (int32_t) do.
+// the pair took two. Lattice indices fit 32 bits as the parents (int32_t) do.
 uint64_t queue_item(float cost, int64_t index) { return core::queue_key(cost, static_cast<uint32_t>(index)); }
 int64_t queue_index(uint64_t item) { return core::queue_key_index(item); }
 using Queue = std::priority_queue<uint64_t, std::vector<uint64_t>, std::greater<uint64_t>>;
@@ -448,7 +447,7 @@ GridSearch::Result GridSearch::distances(const Eigen::Vector3d& source, bool esc
   }
   // Each target is served by its column and the eight around it.
   // Per column the first of the targets it serves, chained through serve_next (-1 ends): read for
-  // every column settled, where a hash map's lookup was a tenth of the search.
+  // every column settled, so an array, not a hash map.
   std::vector<int32_t> serve_head(static_cast<size_t>(plane), -1);
   std::vector<std::pair<int32_t, int32_t>> serve_next;  // (target, next)
   std::vector<std::vector<int64_t>> near(targets.size());
@@ -645,7 +644,6 @@ bool GridSearch::find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, c
     reached = i == goal;
     return reached;
   });
-
   if (expanded) *expanded = n;
   if (!reached) return false;
   std::vector<Eigen::Vector3d> rev{b};
