@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "semx/planner/planner_config.hpp"
 
@@ -162,6 +163,19 @@ TEST(PlannerConfig, TheShippedAblationsLoad) {
   EXPECT_EQ(load_config<PlannerConfig>(dir + "unexplored_weight_0.003.yaml").reward.unexplored_weight, 0.003);
   EXPECT_EQ(load_config<PlannerConfig>(dir + "passage_weight_0.001.yaml").reward.passage_weight, 0.001);
   EXPECT_EQ(load_config<PlannerConfig>(dir + "passage_weight_0.0003.yaml").reward.passage_weight, 0.0003);
+  const PlannerConfig tour = load_config<PlannerConfig>(dir + "fuel_latency_tour.yaml");
+  EXPECT_TRUE(tour.fuel.latency_tour);
+  EXPECT_FALSE(tour.fuel.latency_gain);
+  const PlannerConfig gain = load_config<PlannerConfig>(dir + "fuel_latency_gain.yaml");
+  EXPECT_TRUE(gain.fuel.latency_tour && gain.fuel.latency_gain);
+  // Every file there is one a bench can be given (`--arg planner_config=...`).
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++files;
+    EXPECT_NO_THROW(load_config<PlannerConfig>(entry.path().string())) << entry.path();
+  }
+  EXPECT_GE(files, 7);
 }
 
 TEST(PlannerConfig, OverridesAndErrors) {
