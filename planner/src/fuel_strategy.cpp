@@ -624,9 +624,23 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     // paths of 11.7-11.9 m segments rejected in 2.5 s bursts, each goal skipped after).
     g.waypoints = split_long_segments(waypoints, 9.0);
     g.yaws = turn_early_yaws(g.waypoints, vehicle_yaw_, g.yaw, cost.velocity, cost.yaw_rate);
+    square_near_obstacles(g.waypoints, g.yaws);
     return p;
   }
   return std::nullopt;
+}
+
+void FuelStrategy::square_near_obstacles(const std::vector<Eigen::Vector3d>& w,
+                                         std::vector<double>& yaws) const {
+  const double c = config_.fuel.square_clearance;
+  if (!(c > 0.0)) return;
+  // The first waypoint is the vehicle and the last the view, whose yaw is what the path is for.
+  for (size_t i = 1; i + 1 < w.size() && i + 1 < yaws.size(); ++i) {
+    if (checker_.esdf(w[i], c) >= c) continue;
+    const Eigen::Vector3d d = w[i + 1] - w[i - 1];
+    if (d.head<2>().norm() < 1e-6) continue;
+    yaws[i] = std::atan2(d.y(), d.x());
+  }
 }
 
 PlanOutcome FuelStrategy::plan(PlanContext& ctx) {

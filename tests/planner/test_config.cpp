@@ -120,6 +120,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.search_step);
   SAME(fuel.low_clearance_penalty);
   SAME(fuel.cost_budget);
+  SAME(fuel.square_clearance);
   SAME(semantic_fuel.object_pockets);
   SAME(semantic_fuel.object_margin);
   SAME(semantic_fuel.object_reach);

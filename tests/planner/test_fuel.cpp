@@ -644,6 +644,40 @@ TEST(Fuel, ExploresTwoRoomsToDoneWithoutCollisions) {
   EXPECT_NE(r.reason.find("no frontier cluster with a reachable viewpoint"), std::string::npos) << r.reason;
 }
 
+// fuel.square_clearance: an interior waypoint nearer an obstacle than that holds the direction of
+// travel (the controller's check of the turned body sent such early turns to its slow fallback);
+// off, the early turn toward the view's yaw stays.
+TEST(Fuel, WaypointsNearAnObstacleHoldTheDirectionOfTravel) {
+  for (const double clearance : {0.0, 0.7}) {
+    PlannerConfig c = test_config("fuel");
+    c.fuel.square_clearance = clearance;
+    ExplorationPlanner p(c);
+    ExplorationSimOptions o;
+    o.max_time = 120;
+    const SyntheticWorld w = SyntheticWorld::two_rooms();
+    ExplorationSim sim(w, p, o);
+    CollisionChecker checker{c.collision};
+    int near = 0, square = 0;
+    sim.run([&](double, const ExplorationPlanner::Output& out) {
+      if (!out.path) return;
+      checker.set_grid(&sim.known());
+      const std::vector<Eigen::Vector3d>& wp = out.path->waypoints;
+      for (size_t i = 1; i + 1 < wp.size(); ++i) {
+        const Eigen::Vector3d d = wp[i + 1] - wp[i - 1];
+        if (checker.esdf(wp[i], 0.7) >= 0.7 || d.head<2>().norm() < 1e-6) continue;
+        ++near;
+        if (std::abs(core::wrap_angle(out.path->yaws[i] - std::atan2(d.y(), d.x()))) < 1e-9) ++square;
+      }
+    });
+    ASSERT_GT(near, 0) << "no waypoint near a wall to check";
+    if (clearance > 0) {
+      EXPECT_EQ(square, near);
+    } else {
+      EXPECT_LT(square, near);
+    }
+  }
+}
+
 TEST(Fuel, ExploresTheApartmentToDone) {
   // Six rooms off a corridor (env3's size): every room visited, 95 % well before the end.
   FuelAudit audit;

@@ -146,6 +146,9 @@ class FuelStrategy : public Strategy {
   int64_t successor(const Target& t) const;
   double remaining_fraction(const PlanContext& ctx, const Target& t) const;
 
+  // fuel.square_clearance: the interior waypoints near an obstacle hold the direction of travel.
+  void square_near_obstacles(const std::vector<Eigen::Vector3d>& waypoints, std::vector<double>& yaws) const;
+
   PlannerConfig config_;
   CollisionChecker checker_;
   GainEvaluator gains_;
