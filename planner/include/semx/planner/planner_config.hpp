@@ -433,9 +433,9 @@ struct FuelConfig {
   bool latency_gain = false;
   // m, 0 = off: an interior waypoint of a flown path whose clearance (the ESDF) is below this holds
   // the direction of travel instead of the early turn to the view's yaw, as DEP holds it through
-  // doorways. In the process set the controller sent such paths, turned early near a wall, to its
-  // fallback (0.5 m/s, stopping at every waypoint) for the turned body's reach (docs/planner.md,
-  // "The latency tour weighed by the gain, with object pockets").
+  // doorways. Tried against the controller's fallbacks for the turned body's reach in env3's
+  // process set; they were no fewer with it (docs/planner.md, "The latency tour weighed by the
+  // gain, with object pockets"), so it is off.
   double square_clearance = 0.0;
   // The grid search (grid_search.hpp): coarse cells of search_step voxels for travel costs, and
   // how much more a step costs where the clearance is below collision.passage_clearance.
