@@ -27,16 +27,65 @@ int square_headings_near_obstacles(const std::vector<Eigen::Vector3d>& polyline,
   return turned;
 }
 
-bool hold_heading_square_at(std::vector<double>& times, std::vector<double>& yaws, double t, double yaw_at_t,
-                            const Eigen::Vector3d& gradient, double hold) {
-  const Eigen::Vector2d g2 = gradient.head<2>();
-  if (times.size() < 2 || times.size() != yaws.size() || !(g2.norm() > kRidgeGradient)) return false;
-  if (!(t > times.front()) || !(t < times.back()) || !(hold > 0.0)) return false;
-  const double face = std::atan2(g2.y(), g2.x());
-  const double square = yaw_at_t + std::remainder(face - yaw_at_t, M_PI / 2.0);
-  // Inside the first and last knots, so that the vehicle's and the goal's headings stay.
-  const double a = std::max(t - hold, 0.5 * (times.front() + t));
-  const double b = std::min(t + hold, 0.5 * (t + times.back()));
+HeadingRamp heading_for_limits(double yaw, const std::vector<ReachLimit>& limits, double max_rate,
+                               double half_xy, double half_z) {
+  HeadingRamp best{limits.empty() ? 0.0 : limits.front().time, yaw, 0.0};
+  if (limits.empty()) return best;
+  double first = limits.front().time, last = first;
+  for (const ReachLimit& l : limits) {
+    first = std::min(first, l.time);
+    last = std::max(last, l.time);
+  }
+  best.time = first;
+  const auto room = [&](const HeadingRamp& r) {
+    double least = 1e300;
+    for (const ReachLimit& l : limits)
+      least = std::min(least, l.allowed - footprint_reach(l.direction, r.at(l.time), half_xy, half_z));
+    return least;
+  };
+  // The room is the smallest of a few piecewise-sinusoidal functions of the heading: each limit's
+  // own square (its best) and a grid of 0.5° between, then 0.05° around the best, find its maximum
+  // within a millimetre.
+  std::vector<double> headings;
+  constexpr double kQuarter = M_PI / 2.0, kStep = M_PI / 360.0;
+  for (const ReachLimit& l : limits) {
+    const Eigen::Vector2d d = l.direction.head<2>();
+    if (d.norm() > 0.0) headings.push_back(yaw + std::remainder(std::atan2(d.y(), d.x()) - yaw, kQuarter));
+  }
+  for (double turn = -kQuarter / 2; turn <= kQuarter / 2 + 1e-12; turn += kStep)
+    headings.push_back(yaw + turn);
+  // Rates only where the limits span time; 0 first, so a steady heading wins a tie.
+  std::vector<double> rates = {0.0};
+  if (last - first > 1e-6 && max_rate > 0.0) {
+    constexpr int kRates = 5;
+    for (int k = 1; k <= kRates; ++k)
+      rates.insert(rates.end(), {max_rate * k / kRates, -max_rate * k / kRates});
+  }
+  double best_room = room(best);
+  const auto consider = [&](const HeadingRamp& c) {
+    const double r = room(c);
+    const bool steadier = std::abs(c.rate) < std::abs(best.rate) - 1e-12;
+    const bool as_steady = std::abs(c.rate) < std::abs(best.rate) + 1e-12;
+    if (r > best_room + 1e-12 ||
+        (r > best_room - 1e-12 &&
+         (steadier || (as_steady && std::abs(c.yaw - yaw) < std::abs(best.yaw - yaw))))) {
+      best = c;
+      best_room = r;
+    }
+  };
+  for (const double rate : rates)
+    for (const double h : headings) consider(HeadingRamp{first, h, rate});
+  const HeadingRamp coarse = best;
+  for (int k = -10; k <= 10; ++k) consider(HeadingRamp{first, coarse.yaw + k * kStep / 10, coarse.rate});
+  return best;
+}
+
+bool hold_heading(std::vector<double>& times, std::vector<double>& yaws, double inner_a, double inner_b,
+                  double hold, const HeadingRamp& ramp) {
+  if (times.size() < 2 || times.size() != yaws.size() || !(inner_a <= inner_b)) return false;
+  if (!(inner_a > times.front()) || !(inner_b < times.back()) || !(hold > 0.0)) return false;
+  const double a = std::max(inner_a - hold, 0.5 * (times.front() + inner_a));
+  const double b = std::min(inner_b + hold, 0.5 * (inner_b + times.back()));
   std::vector<double> nt, ny;
   nt.reserve(times.size() + 2);
   ny.reserve(times.size() + 2);
@@ -45,7 +94,7 @@ bool hold_heading_square_at(std::vector<double>& times, std::vector<double>& yaw
     if (inner && times[k] >= a && times[k] <= b) continue;
     if (times[k] > b && (nt.empty() || nt.back() < a)) {
       nt.insert(nt.end(), {a, b});
-      ny.insert(ny.end(), {square, square});
+      ny.insert(ny.end(), {ramp.at(a), ramp.at(b)});
     }
     nt.push_back(times[k]);
     ny.push_back(yaws[k]);

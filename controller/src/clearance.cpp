@@ -82,8 +82,9 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
     }
     if (!escaping && footprint && g.norm() > kRidgeGradient) {
       // The gradient points away from the nearest obstacle; the reach is symmetric.
-      const double deficit = footprint_reach(g.normalized(), trajectory.yaw.evaluate(t, 0)(0),
-                                             rule.footprint_half_xy, rule.footprint_half_z) +
+      const Eigen::Vector3d n = g.normalized();
+      const double deficit = footprint_reach(n, trajectory.yaw.evaluate(t, 0)(0), rule.footprint_half_xy,
+                                             rule.footprint_half_z) +
                              rule.footprint_margin - low;
       if (reach_escape_may_start && deficit > 0.0 && rule.allow_escape)
         reach_deficit_allowed = deficit + rule.escape_slack;
@@ -91,6 +92,8 @@ ClearanceReport check_clearance(const Trajectory& trajectory, const DistanceFiel
         reach_deficit_allowed = 0.0;  // out: from here on the full reach applies
       } else if (deficit > reach_deficit_allowed) {
         r.footprint = true;
+        r.violation_normal = n;
+        r.reach_allowed = low - rule.footprint_margin + reach_deficit_allowed;
         fail(t, p, d);
         return r;
       }

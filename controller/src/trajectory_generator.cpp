@@ -64,22 +64,66 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   std::vector<double> scaled(times);
   for (double& t : scaled) t *= k;
   const PositionSpline curve = trajectory.position;  // the yaw profile may add a hover at its end
-  // One heading target checked against `rule`, held square where the turned body fails, at most
-  // `repairs` times.
-  const auto check = [&](const ClearanceRule& rule, int repairs) {
-    std::vector<double> knots(scaled), targets(yaws);
+  // One heading target checked against `rule`, held where the turned body fails, at most `repairs`
+  // times. Each failing instant first gets its own hold, a later one replacing the knots of an
+  // earlier one it overlaps. When that does not pass, `merge`: a failure within two holds' length
+  // of a held one joins it, and one heading must meet both. A doorway's two jamb ends, passed a
+  // few centimetres apart, want different squares, and holding each square in turn undid the
+  // other (env3, a door of the east rooms: eight repairs alternated between 173° and 23°, and the
+  // path went to the fallback). But a heading that turns within the doorway may pass where no one
+  // heading does (a lintel's edge, then the jambs), so merging is the second try, not the rule.
+  struct Hold {
+    double first, last;  // the failing instants it holds for
+    double yaw_ref;      // the heading the curve had at the first of them
+    HeadingRamp heading;
+    std::vector<ReachLimit> limits;
+  };
+  const double hold = config_.clearance.heading_hold;
+  // A ramp the yaw profile can follow with room to spare: it also has to turn into it.
+  const double max_rate = 0.5 * config_.limits.max_yaw_rate;
+  const auto check = [&](const ClearanceRule& rule, int repairs, bool merge) {
+    std::vector<Hold> holds;
     result.repaired_headings = 0;
     for (int attempt = 0;; ++attempt) {
+      std::vector<double> knots(scaled), targets(yaws);
+      for (const Hold& h : holds) hold_heading(knots, targets, h.first, h.last, hold, h.heading);
       trajectory.position = curve;
       add_yaw_profile(trajectory, knots, targets, config_.limits.max_yaw_rate);
       result.clearance = check_clearance(trajectory, field, 0.0, trajectory.duration(), rule);
       if (result.clearance.ok || !result.clearance.footprint || attempt >= repairs) break;
       const double t = result.clearance.violation_time;
-      Eigen::Vector3d g;
-      field.distance(result.clearance.violation_point, &g);
-      if (!hold_heading_square_at(knots, targets, t, trajectory.yaw.evaluate(t, 0)(0), g,
-                                  config_.clearance.heading_hold))
+      if (!(t > knots.front() && t < knots.back()) ||
+          !(result.clearance.violation_normal.head<2>().norm() > 0.0))
         break;
+      const ReachLimit limit{t, result.clearance.violation_normal, result.clearance.reach_allowed};
+      auto near = !merge ? holds.end() : std::find_if(holds.begin(), holds.end(), [&](const Hold& h) {
+        return t >= h.first - 2.0 * hold && t <= h.last + 2.0 * hold;
+      });
+      if (near == holds.end()) {
+        const double yaw = trajectory.yaw.evaluate(t, 0)(0);
+        holds.push_back(Hold{t, t, yaw, HeadingRamp{t, yaw, 0.0}, {}});
+        near = holds.end() - 1;
+      }
+      near->first = std::min(near->first, t);
+      near->last = std::max(near->last, t);
+      near->limits.push_back(limit);
+      near->heading = heading_for_limits(near->yaw_ref, near->limits, max_rate, rule.footprint_half_xy,
+                                         rule.footprint_half_z);
+      // A hold that grew may now overlap the next: merged, they too share one heading.
+      if (merge)
+        std::sort(holds.begin(), holds.end(), [](const Hold& a, const Hold& b) { return a.first < b.first; });
+      for (std::size_t k = 1; merge && k < holds.size();) {
+        Hold& a = holds[k - 1];
+        if (holds[k].first - 2.0 * hold > a.last) {
+          ++k;
+          continue;
+        }
+        a.last = std::max(a.last, holds[k].last);
+        a.limits.insert(a.limits.end(), holds[k].limits.begin(), holds[k].limits.end());
+        a.heading =
+            heading_for_limits(a.yaw_ref, a.limits, max_rate, rule.footprint_half_xy, rule.footprint_half_z);
+        holds.erase(holds.begin() + static_cast<std::ptrdiff_t>(k));
+      }
       ++result.repaired_headings;
     }
     if (!result.clearance.ok) result.repaired_headings = 0;
@@ -87,16 +131,19 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   };
   const ClearanceRule rule = generation_rule(trajectory.optimized);
   // Only the turned-body rule depends on the heading, and only optimised curves are held to it.
-  if (rule.footprint_half_xy > 0.0) return check(rule, config_.clearance.heading_repairs);
+  const int repairs = config_.clearance.heading_repairs;
+  if (rule.footprint_half_xy > 0.0)
+    return check(rule, repairs, false) || (repairs > 0 && check(rule, repairs, true));
   // The fallback is the planner's path, whose clearance the turned body need not keep (a doorway's
   // centre line is 0.35 m from its jambs), but its heading is free: held square where the body
   // would touch when that suffices, as it is, bound only, when it does not. It had flown
   // diagonally past a wall's end 0.35 m away with its corner 0.327 m out, touched it and stayed
   // there (env3, fuel's latency tour, seed 1, at 154 s).
   if (config_.clearance.square_fallback && config_.clearance.turned_body) {
-    if (check(generation_rule(true), config_.clearance.heading_repairs)) return true;
+    const ClearanceRule body = generation_rule(true);
+    if (check(body, repairs, false) || (repairs > 0 && check(body, repairs, true))) return true;
   }
-  return check(rule, 0);
+  return check(rule, 0, false);
 }
 
 Eigen::Vector3d TrajectoryGenerator::start_velocity(const StartState& start, double v_max) {

@@ -94,11 +94,15 @@ TEST(BodyHeading, TheFallbackThroughATightPointKeepsTheTurnedBodyOffTheEdge) {
   EXPECT_TRUE(check_clearance(held.trajectory, field, 0, held.trajectory.duration(), body).ok);
 }
 
-TEST(BodyHeading, HoldingTheHeadingSquareReplacesTheKnotsAroundTheInstant) {
+TEST(BodyHeading, HoldingTheHeadingReplacesTheKnotsAroundTheInstant) {
   std::vector<double> times = {0.0, 1.0, 2.0, 3.0, 4.0};
   std::vector<double> yaws = {0.0, 0.7, 0.7, 0.7, 0.7};
   // The obstacle along +y: a face looks along it at every quarter turn; the nearest to 0.7 rad is 0.
-  ASSERT_TRUE(hold_heading_square_at(times, yaws, 2.1, 0.7, Eigen::Vector3d(0, 1, 0), 0.3));
+  const HeadingRamp square =
+      heading_for_limits(0.7, {ReachLimit{2.1, Eigen::Vector3d(0, 1, 0), 0.3}}, 0.5, kHalf, 0.15);
+  EXPECT_NEAR(square.yaw, 0.0, 1e-12);
+  EXPECT_EQ(square.rate, 0.0) << "one instant: a steady heading";
+  ASSERT_TRUE(hold_heading(times, yaws, 2.1, 2.1, 0.3, square));
   EXPECT_EQ(times, std::vector<double>({0.0, 1.0, 1.8, 2.4, 3.0, 4.0}));
   ASSERT_EQ(yaws.size(), 6u);
   EXPECT_NEAR(yaws[2], 0.0, 1e-12);
@@ -107,23 +111,69 @@ TEST(BodyHeading, HoldingTheHeadingSquareReplacesTheKnotsAroundTheInstant) {
   EXPECT_EQ(yaws.back(), 0.7);
   // Near the ends the hold shrinks so the vehicle's and the goal's headings stay first and last.
   std::vector<double> t2 = {0.0, 1.0}, y2 = {0.0, 0.0};
-  ASSERT_TRUE(hold_heading_square_at(t2, y2, 0.9, 0.2, Eigen::Vector3d(1, 0, 0), 0.3));
+  ASSERT_TRUE(hold_heading(t2, y2, 0.9, 0.9, 0.3, HeadingRamp{0.9, 0.2, 0.0}));
   EXPECT_EQ(t2.front(), 0.0);
   EXPECT_EQ(t2.back(), 1.0);
   EXPECT_EQ(y2.back(), 0.0);
-  EXPECT_NEAR(y2[1], 0.0, 1e-12);
-  // Unknown direction (a ridge) or an instant outside the target: nothing to do.
+  EXPECT_NEAR(y2[1], 0.2, 1e-12);
+  // Instants outside the target, or in the wrong order: nothing to do.
   std::vector<double> t3 = times, y3 = yaws;
-  EXPECT_FALSE(hold_heading_square_at(t3, y3, 2.1, 0.7, Eigen::Vector3d(0.1, 0.1, 0), 0.3));
-  EXPECT_FALSE(hold_heading_square_at(t3, y3, 4.5, 0.7, Eigen::Vector3d(0, 1, 0), 0.3));
+  EXPECT_FALSE(hold_heading(t3, y3, 4.5, 4.5, 0.3, HeadingRamp{}));
+  EXPECT_FALSE(hold_heading(t3, y3, 2.5, 2.0, 0.3, HeadingRamp{}));
   EXPECT_EQ(t3, times);
+  // A turning hold: its knots lie on the ramp.
+  std::vector<double> t4 = {0.0, 4.0}, y4 = {0.0, 0.0};
+  ASSERT_TRUE(hold_heading(t4, y4, 2.0, 2.5, 0.3, HeadingRamp{2.0, 0.1, 0.2}));
+  EXPECT_EQ(t4, std::vector<double>({0.0, 1.7, 2.8, 4.0}));
+  EXPECT_NEAR(y4[1], 0.1 - 0.2 * 0.3, 1e-12);
+  EXPECT_NEAR(y4[2], 0.1 + 0.2 * 0.8, 1e-12);
+}
+
+TEST(BodyHeading, TwoJambsThatWantDifferentSquaresGetOneHeadingBetweenThem) {
+  // A door of env3's east rooms, as the controller met it (semx-controller-replay): the curve
+  // passes the two jamb ends 0.06 m and 0.06 s apart, their directions 173° and 23° (away from
+  // each), 0.321 and 0.333 m of reach allowed; then the near jamb again (0.327 m), and the far
+  // side's jamb, -24° and 0.327 m, 0.3 s later. Either near jamb's square heading is diagonal to the other.
+  const auto unit = [](double deg) {
+    return Eigen::Vector3d(std::cos(deg * M_PI / 180), std::sin(deg * M_PI / 180), 0.0);
+  };
+  const ReachLimit a{8.17, unit(172.8), 0.321}, b{8.11, unit(23.2), 0.333}, c{8.47, unit(-24.2), 0.327},
+      b2{8.13, unit(23.0), 0.327};
+  const auto meets = [&](const ReachLimit& l, const HeadingRamp& h) {
+    return footprint_reach(l.direction, h.at(l.time), kHalf, 0.15) <= l.allowed;
+  };
+  const double yaw = 23.3 * M_PI / 180;  // the curve's own heading there
+  const double rate = 0.5;               // rad/s, half the vehicle's yaw rate
+  const HeadingRamp square_a = heading_for_limits(yaw, {a}, rate, kHalf, 0.15);
+  const HeadingRamp square_b = heading_for_limits(yaw, {b}, rate, kHalf, 0.15);
+  EXPECT_TRUE(meets(a, square_a));
+  EXPECT_FALSE(meets(b, square_a));
+  EXPECT_TRUE(meets(b, square_b));
+  EXPECT_FALSE(meets(a, square_b));
+  const HeadingRamp both = heading_for_limits(yaw, {a, b}, rate, kHalf, 0.15);
+  EXPECT_TRUE(meets(a, both)) << both.yaw * 180 / M_PI;
+  EXPECT_TRUE(meets(b, both)) << both.yaw * 180 / M_PI;
+  EXPECT_LE(std::abs(both.yaw - yaw), M_PI / 4 + 1e-9);
+  EXPECT_LE(std::abs(both.rate), rate + 1e-12);
+  // With the far jamb too no steady heading is enough; one that turns, slower than `rate`, is.
+  const HeadingRamp steady = heading_for_limits(yaw, {a, b, b2, c}, 0.0, kHalf, 0.15);
+  EXPECT_FALSE(meets(a, steady) && meets(b, steady) && meets(b2, steady) && meets(c, steady))
+      << steady.yaw * 180 / M_PI;
+  const HeadingRamp turning = heading_for_limits(yaw, {a, b, b2, c}, rate, kHalf, 0.15);
+  EXPECT_TRUE(meets(a, turning) && meets(b, turning) && meets(b2, turning) && meets(c, turning))
+      << turning.yaw * 180 / M_PI << " " << turning.rate;
+  EXPECT_NE(turning.rate, 0.0);
+  EXPECT_LE(std::abs(turning.rate), rate + 1e-12);
+  // A heading that already meets one limit with the most room stays where it is.
+  EXPECT_NEAR(heading_for_limits(0.0, {ReachLimit{1.0, unit(90), 0.3}}, rate, kHalf, 0.15).yaw, 0.0, 1e-12);
 }
 
 // The two jambs of a doorway, vertical posts at (x, ±half_gap): the distance to the nearer one.
 class DoorwayField : public DistanceField {
  public:
   DoorwayField(double x, double half_gap)
-      : a_(Eigen::Vector2d(x, half_gap)), b_(Eigen::Vector2d(x, -half_gap)) {}
+      : DoorwayField(Eigen::Vector2d(x, half_gap), Eigen::Vector2d(x, -half_gap)) {}
+  DoorwayField(const Eigen::Vector2d& a, const Eigen::Vector2d& b) : a_(a), b_(b) {}
   double distance(const Eigen::Vector3d& p, Eigen::Vector3d* g = nullptr) const override {
     const double da = a_.distance(p, g);
     Eigen::Vector3d gb;
@@ -164,6 +214,35 @@ TEST(BodyHeading, AnOptimisedCurveThroughADoorwayHoldsItsHeadingSquareInsteadOfT
   EXPECT_TRUE(check_clearance(r.trajectory, field, 0, r.trajectory.duration(), gen.generation_rule(true)).ok);
   EXPECT_LT(r.trajectory.duration(), 0.6 * plain.trajectory.duration());
   // The goal keeps the heading the planner asked for.
+  EXPECT_NEAR(r.trajectory.yaw.evaluate(r.trajectory.duration(), 0)(0), yaws.back(), 1e-9);
+}
+
+TEST(BodyHeading, StaggeredJambsGetOneHeadingForBothInsteadOfTheFallback) {
+  // The jambs' ends 0.68 m apart and 0.1 m apart along the way, the camera 35° off the direction
+  // of travel. Holding each jamb's square in turn, the later hold replaced the earlier one and
+  // the curve failed again at the first jamb: the path was flown slowed or on the fallback. The
+  // holds joined, one heading (or a slow turn) meets both.
+  const DoorwayField field(Eigen::Vector2d(2.0, 0.34), Eigen::Vector2d(2.1, -0.34));
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {1.2, 0, 1}, {2.8, 0, 1}, {4, 0, 1}};
+  const std::vector<double> yaws(pts.size(), 35.0 * M_PI / 180);
+  StartState start;
+  start.position = pts[0];
+  start.yaw = yaws[0];
+  ControllerConfig cfg;
+  cfg.clearance.heading_repairs = 0;
+  const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(plain.ok) << plain.reason;
+  EXPECT_FALSE(plain.trajectory.optimized);
+
+  cfg.clearance.heading_repairs = 8;
+  const TrajectoryGenerator gen(cfg);
+  const GenerationResult r = gen.generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_TRUE(r.trajectory.optimized) << r.reason;
+  EXPECT_FALSE(r.slowed) << r.reason;
+  EXPECT_GE(r.repaired_headings, 2);
+  EXPECT_TRUE(check_clearance(r.trajectory, field, 0, r.trajectory.duration(), gen.generation_rule(true)).ok);
+  EXPECT_LT(r.trajectory.duration(), 0.65 * plain.trajectory.duration());
   EXPECT_NEAR(r.trajectory.yaw.evaluate(r.trajectory.duration(), 0)(0), yaws.back(), 1e-9);
 }
 

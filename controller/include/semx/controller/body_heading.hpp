@@ -23,17 +23,44 @@ namespace semx::controller {
 int square_headings_near_obstacles(const std::vector<Eigen::Vector3d>& polyline, std::vector<double>& yaws,
                                    const DistanceField& field, double within);
 
+// Where a curve broke the turned-body rule: when, the nearest obstacle's direction (unit, the
+// ESDF gradient) and the farthest the body may reach toward it there
+// (ClearanceReport::reach_allowed).
+struct ReachLimit {
+  double time = 0.0;  // s
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double allowed = 0.0;  // m
+};
+
+// A heading that turns at a constant rate: yaw + rate·(t - time).
+struct HeadingRamp {
+  double time = 0.0;
+  double yaw = 0.0;
+  double rate = 0.0;  // rad/s
+  double at(double t) const { return yaw + rate * (t - time); }
+};
+
+// The ramp through `limits` (a heading within 45° of `yaw` at the first limit's time, the body's
+// reach repeating every quarter turn, and a rate of at most `max_rate`) that leaves the body the
+// most room (the largest smallest allowed - footprint_reach); of equally good ones the steadiest
+// and nearest to `yaw`. One limit: a face square to its obstacle. A doorway's two jamb ends, passed
+// a few centimetres and hundredths of a second apart, want different squares (env3, a door of the
+// east rooms: 173° and 23°): no square heading passes both, a heading between them does, and a
+// third limit a few tenths of a second on (the far side's jamb, -24°) a heading that turns.
+HeadingRamp heading_for_limits(double yaw, const std::vector<ReachLimit>& limits, double max_rate,
+                               double half_xy, double half_z);
+
 // An optimised curve cuts the path's corners, so it may pass an obstacle closer than a corner's
 // reach where no path point does, heading diagonally to it: the turned-body rule then sent the
 // whole path to the fallback, which stops at every waypoint at half speed (env3, semantic-dep,
-// seed 8: 8 such fallbacks in its first 200 s, 85 % only at 168 s). This holds the heading target
-// square to the obstacle around the failing instant instead: knots (t - hold, face) and
-// (t + hold, face) of the piecewise-linear heading target (times, yaws; yaw_profile.hpp) replace
-// the knots between them, `face` the turn of at most 45° from `yaw_at_t` that makes a face of the
-// body look along `gradient`. The first and last knots (the vehicle's heading, the goal's) are
-// kept. Returns false when the obstacle's direction is unknown (|gradient_xy| at most the ridge
-// threshold) or t is not inside the target.
-bool hold_heading_square_at(std::vector<double>& times, std::vector<double>& yaws, double t, double yaw_at_t,
-                            const Eigen::Vector3d& gradient, double hold);
+// seed 8: 8 such fallbacks in its first 200 s, 85 % only at 168 s). The generator holds the
+// heading target instead (TrajectoryGenerator, clearance.heading_repairs): knots
+// (inner_a - hold, ramp) and (inner_b + hold, ramp) of the piecewise-linear heading target (times,
+// yaws; yaw_profile.hpp) replace the knots between them, [inner_a, inner_b] the failing instants.
+// Near the first and last knots the hold ends halfway to them, so that the vehicle's heading and
+// the goal's stay. Returns false, changing nothing, when the instants are
+// not inside the target.
+bool hold_heading(std::vector<double>& times, std::vector<double>& yaws, double inner_a, double inner_b,
+                  double hold, const HeadingRamp& ramp);
 
 }  // namespace semx::controller

@@ -53,6 +53,10 @@ struct ClearanceReport {
   Eigen::Vector3d violation_point = Eigen::Vector3d::Zero();
   double violation_distance = 0.0;
   bool footprint = false;  // the violation is the turned body's reach, not `bound`
+  // A footprint violation's obstacle direction (the unit ESDF gradient, pointing away from it) and
+  // the farthest the body may reach toward it there: what a heading must meet (body_heading.hpp).
+  Eigen::Vector3d violation_normal = Eigen::Vector3d::Zero();
+  double reach_allowed = 0.0;
   int samples = 0;
 };
 
