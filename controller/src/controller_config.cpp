@@ -23,6 +23,7 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   cl.get("square_headings", c.clearance.square_headings);
   cl.get("heading_repairs", c.clearance.heading_repairs, 0, 100);
   cl.get("heading_hold", c.clearance.heading_hold, 0.01, 10.0);
+  cl.get("join_holds", c.clearance.join_holds);
   cl.get("square_fallback", c.clearance.square_fallback);
   cl.get("check_spacing", c.clearance.check_spacing, 0.001, 0.5);
   cl.get("allow_escape", c.clearance.allow_escape);

@@ -132,8 +132,9 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   const ClearanceRule rule = generation_rule(trajectory.optimized);
   // Only the turned-body rule depends on the heading, and only optimised curves are held to it.
   const int repairs = config_.clearance.heading_repairs;
+  const bool join = repairs > 0 && config_.clearance.join_holds;
   if (rule.footprint_half_xy > 0.0)
-    return check(rule, repairs, false) || (repairs > 0 && check(rule, repairs, true));
+    return check(rule, repairs, false) || (join && check(rule, repairs, true));
   // The fallback is the planner's path, whose clearance the turned body need not keep (a doorway's
   // centre line is 0.35 m from its jambs), but its heading is free: held square where the body
   // would touch when that suffices, as it is, bound only, when it does not. It had flown
@@ -141,7 +142,7 @@ bool TrajectoryGenerator::finish(Trajectory& trajectory, const std::vector<doubl
   // there (env3, fuel's latency tour, seed 1, at 154 s).
   if (config_.clearance.square_fallback && config_.clearance.turned_body) {
     const ClearanceRule body = generation_rule(true);
-    if (check(body, repairs, false) || (repairs > 0 && check(body, repairs, true))) return true;
+    if (check(body, repairs, false) || (join && check(body, repairs, true))) return true;
   }
   return check(rule, 0, false);
 }

@@ -235,6 +235,12 @@ TEST(BodyHeading, StaggeredJambsGetOneHeadingForBothInsteadOfTheFallback) {
   EXPECT_FALSE(plain.trajectory.optimized);
 
   cfg.clearance.heading_repairs = 8;
+  cfg.clearance.join_holds = false;
+  const GenerationResult apart = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
+  ASSERT_TRUE(apart.ok) << apart.reason;
+  EXPECT_TRUE(apart.slowed || !apart.trajectory.optimized) << "each hold undoes the other";
+
+  cfg.clearance.join_holds = true;
   const TrajectoryGenerator gen(cfg);
   const GenerationResult r = gen.generate(pts, yaws, start, 0.0, field);
   ASSERT_TRUE(r.ok) << r.reason;

@@ -1,6 +1,8 @@
 // The controller's configuration: defaults, the documented YAML file, strictness.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "semx/controller/controller_config.hpp"
 
 using namespace semx::controller;
@@ -30,6 +32,7 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(clearance.turned_body);
   SAME(clearance.heading_repairs);
   SAME(clearance.heading_hold);
+  SAME(clearance.join_holds);
   SAME(trajectory.max_deviation);
   SAME(optimizer.max_iterations);
   SAME(optimizer.weight_smoothness);
@@ -53,6 +56,20 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(safety.max_odometry_age);
   SAME(safety.max_esdf_age);
 #undef SAME
+}
+
+TEST(ControllerConfig, TheShippedAblationsLoad) {
+  const std::string dir = std::string(SEMX_SOURCE_DIR) + "/controller/config/ablations/";
+  EXPECT_EQ(load_config<ControllerConfig>(dir + "no_fidelity.yaml").optimizer.weight_fidelity, 0.0);
+  EXPECT_FALSE(load_config<ControllerConfig>(dir + "no_join_holds.yaml").clearance.join_holds);
+  // Every file there is one a bench can be given (`--arg controller_config=...`).
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++files;
+    EXPECT_NO_THROW(load_config<ControllerConfig>(entry.path().string())) << entry.path();
+  }
+  EXPECT_GE(files, 3);
 }
 
 TEST(ControllerConfig, OverridesAndErrors) {

@@ -56,6 +56,10 @@ struct ClearanceConfig {
   // most heading_repairs times (body_heading.hpp), before the slower curves are tried. 0: off.
   int heading_repairs = 8;
   double heading_hold = 0.3;    // s
+  // When holding each failing instant's square in turn does not pass, try again with failures
+  // within two holds' length joined: one heading, or a turn of at most half max_yaw_rate, that
+  // meets them all (a doorway's two jambs want different squares; each hold undid the other's).
+  bool join_holds = true;
   // The fallback's heading held square the same way where its turned body would touch, when that
   // is enough; otherwise it is flown as it is (its bound is the planner's, see turned_body).
   bool square_fallback = true;
