@@ -62,7 +62,10 @@ class GridSearch {
 
   // A path the vehicle at `a` can fly to `b`: A* over voxels within two coarse cells of `guide`
   // (everywhere when guide is empty), shortened. False when none was found within
-  // max_expansions; `expanded` counts the voxels settled.
+  // max_expansions; `expanded` counts the voxels settled. A start that is not node_free and has
+  // no way off it under the usual rules (the search runs dry within a few thousand voxels, or
+  // every first segment fails edge_free) is searched again under the escape rule, as a start
+  // without the clearance is.
   bool find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const std::vector<Eigen::Vector3d>& guide,
                  int64_t max_expansions, std::vector<Eigen::Vector3d>& out, int64_t* expanded = nullptr);
   // Drops every point of `path` that its neighbours can be joined around with a segment that
@@ -76,6 +79,12 @@ class GridSearch {
   bool body_clear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
  private:
+  // find_path() once; `force_escape`: the escape rule near `a` even where its cell has the
+  // clearance. `pocket` (when given), after a failure without the escape rule: the start had no
+  // way off it (see find_path above), so the escape rule may find one.
+  bool find_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                 const std::vector<Eigen::Vector3d>& guide, int64_t max_expansions,
+                 std::vector<Eigen::Vector3d>& out, int64_t* expanded, bool force_escape, bool* pocket);
   // kEscape: passable only by the escape rule near the search's source (never cached).
   enum : uint8_t { kUnset = 0, kBlocked = 1, kLow = 2, kHigh = 3, kEscape = 4 };
   // A dense box of cells of `stride` voxels, with passability and the search's scratch.
