@@ -16,6 +16,7 @@ if [[ $# -lt 5 ]]; then
   exit 2
 fi
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bin="${SEMX_BUILD_DIR:-$here/build}/bin"  # as ./semx: SEMX_BUILD_DIR picks another build
 out="$1" ours="$2" planners="$3" seeds="$4"
 shift 4
 worlds=()
@@ -29,7 +30,7 @@ for w in "${worlds[@]}"; do
     for ((s = 1; s <= seeds; ++s)); do
       stamp="$out/done/$(basename "$w" .yaml)-$p-seed$s"
       [[ -f "$stamp" ]] && continue
-      "$here/build/bin/semx-perf-planner" --world "$w" --planner "$p" --seed "$s" --runs 1 --semantics \
+      "$bin/semx-perf-planner" --world "$w" --planner "$p" --seed "$s" --runs 1 --semantics \
         --time-split --out "$out" "${extra[@]}" > "$out/last.log" 2>&1 || { cat "$out/last.log" >&2; exit 1; }
       grep -E '^run_(T_coverage|T_time_o|collisions|end):' "$out/last.log" | tr '\n' ' ' | sed "s|^|$(basename "$w" .yaml) $p seed $s: |"
       echo
@@ -37,5 +38,5 @@ for w in "${worlds[@]}"; do
     done
   done
 done
-"$here/build/bin/semx-bench-report" "$out" --sweep-planner "$ours" > /dev/null
+"$bin/semx-bench-report" "$out" --sweep-planner "$ours" > /dev/null
 echo "tools/closed-loop.sh: $out/tables.md"

@@ -468,7 +468,7 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         double w = rep_view(i).coverage;
         if (f.latency_gain) {
           const NodeGain g = gains_.evaluate(*ctx.grid, rep_view(i).position);
-          w = gains_.gain_at_yaw(g, rep_view(i).yaw);
+          w = std::pow(gains_.gain_at_yaw(g, rep_view(i).yaw), f.latency_gain_power);
         }
         weight[static_cast<size_t>(i + 1)] =
             latency_weight(ctx, *clusters_.find(sites_[static_cast<size_t>(i)].cluster), w);

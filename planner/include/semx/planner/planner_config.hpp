@@ -431,6 +431,9 @@ struct FuelConfig {
   // cluster's frontier; true, the volumetric gain G from there in its yaw window (DEP's measure:
   // the unknown space a visit reveals, which a room behind a small doorway frontier has much of).
   bool latency_gain = false;
+  // The latency weight is G raised to this power (latency_gain only): above 1 the sites that look
+  // into space not seen yet (a room behind its door) go before the details near the vehicle.
+  double latency_gain_power = 1.0;
   // m, 0 = off: an interior waypoint of a flown path whose clearance (the ESDF) is below this holds
   // the direction of travel instead of the early turn to the view's yaw, as DEP holds it through
   // doorways. Tried against the controller's fallbacks for the turned body's reach in env3's
