@@ -58,8 +58,7 @@ HeadingRamp heading_for_limits(double yaw, const std::vector<ReachLimit>& limits
 // (inner_a - hold, ramp) and (inner_b + hold, ramp) of the piecewise-linear heading target (times,
 // yaws; yaw_profile.hpp) replace the knots between them, [inner_a, inner_b] the failing instants.
 // Near the first and last knots the hold ends halfway to them, so that the vehicle's heading and
-// the goal's stay. Returns false, changing nothing, when the instants are
-// not inside the target.
+// the goal's stay. Returns false, changing nothing, when the instants are not inside the target.
 bool hold_heading(std::vector<double>& times, std::vector<double>& yaws, double inner_a, double inner_b,
                   double hold, const HeadingRamp& ramp);
 
