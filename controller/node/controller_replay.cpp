@@ -84,14 +84,8 @@ PathReplay replay_paths(const std::string& log_path, const ControllerConfig& con
         ++r.skipped;
         continue;
       }
-      std::vector<double> yaws;
-      const auto polyline = flight_polyline(path, vehicle->position, vehicle->yaw, &yaws);
-      StartState start;
-      start.position = vehicle->position;
-      start.velocity = vehicle->velocity;
-      start.yaw = vehicle->yaw;
-      r.paths.push_back(ReplayedPath{t, path.plan_id, path.waypoints.size(),
-                                     generator.generate(polyline, yaws, start, path.max_speed, *field)});
+      r.paths.push_back(
+          ReplayedPath{t, path.plan_id, path.waypoints.size(), generator.generate(path, *vehicle, *field)});
     }
   }
   r.session = session->summary();

@@ -82,13 +82,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
     reject(path, why, false);
     return;
   }
-  std::vector<double> yaws;
-  const auto polyline = flight_polyline(path, odometry_->position, odometry_->yaw, &yaws);
-  StartState start;
-  start.position = odometry_->position;
-  start.velocity = odometry_->velocity;
-  start.yaw = odometry_->yaw;
-  last_generation_ = generator_.generate(polyline, yaws, start, path.max_speed, *esdf_);
+  last_generation_ = generator_.generate(path, *odometry_, *esdf_);
   if (!last_generation_.ok) {
     reject(path, last_generation_.reason, true);
     return;

@@ -203,6 +203,17 @@ double TrajectoryGenerator::deviation(const PositionSpline& curve,
   return worst;
 }
 
+GenerationResult TrajectoryGenerator::generate(const Path& path, const VehicleState& vehicle,
+                                               const DistanceField& field) const {
+  std::vector<double> yaws;
+  const auto polyline = flight_polyline(path, vehicle.position, vehicle.yaw, &yaws);
+  StartState start;
+  start.position = vehicle.position;
+  start.velocity = vehicle.velocity;
+  start.yaw = vehicle.yaw;
+  return generate(polyline, yaws, start, path.max_speed, field);
+}
+
 GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d>& polyline,
                                                const std::vector<double>& path_yaws, const StartState& start,
                                                double max_speed, const DistanceField& field) const {

@@ -15,6 +15,14 @@ using test::PostField;
 
 constexpr double kHalf = 0.25;
 
+// The vehicle at rest at the path's first point, heading as the planner asks there.
+StartState at_rest(const std::vector<Eigen::Vector3d>& pts, const std::vector<double>& yaws) {
+  StartState s;
+  s.position = pts[0];
+  s.yaw = yaws[0];
+  return s;
+}
+
 double reach_toward_post(const Eigen::Vector3d& p, const Eigen::Vector2d& post, double yaw) {
   const Eigen::Vector2d d = (post - p.head<2>()).normalized();
   return footprint_reach(Eigen::Vector3d(d.x(), d.y(), 0.0), yaw, kHalf, 0.15);
@@ -67,9 +75,7 @@ TEST(BodyHeading, TheFallbackThroughATightPointKeepsTheTurnedBodyOffTheEdge) {
   const PostField field(edge);
   const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {2, 0, 1}, {4, 0, 1}};
   const std::vector<double> yaws = {M_PI / 4, M_PI / 4, M_PI / 4};
-  StartState start;
-  start.position = pts[0];
-  start.yaw = yaws[0];
+  const StartState start = at_rest(pts, yaws);
   const TrajectoryGenerator squared(cfg);
   const GenerationResult r = squared.generate(pts, yaws, start, 0.0, field);
   ASSERT_TRUE(r.ok) << r.reason;
@@ -195,9 +201,7 @@ TEST(BodyHeading, AnOptimisedCurveThroughADoorwayHoldsItsHeadingSquareInsteadOfT
   const DoorwayField field(2.0, 0.36);
   const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {1.2, 0, 1}, {2.8, 0, 1}, {4, 0, 1}};
   const std::vector<double> yaws(pts.size(), M_PI / 4);
-  StartState start;
-  start.position = pts[0];
-  start.yaw = yaws[0];
+  const StartState start = at_rest(pts, yaws);
   ControllerConfig cfg;
   cfg.clearance.heading_repairs = 0;
   const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);
@@ -225,9 +229,7 @@ TEST(BodyHeading, StaggeredJambsGetOneHeadingForBothInsteadOfTheFallback) {
   const DoorwayField field(Eigen::Vector2d(2.0, 0.34), Eigen::Vector2d(2.1, -0.34));
   const std::vector<Eigen::Vector3d> pts = {{0, 0, 1}, {1.2, 0, 1}, {2.8, 0, 1}, {4, 0, 1}};
   const std::vector<double> yaws(pts.size(), 35.0 * M_PI / 180);
-  StartState start;
-  start.position = pts[0];
-  start.yaw = yaws[0];
+  const StartState start = at_rest(pts, yaws);
   ControllerConfig cfg;
   cfg.clearance.heading_repairs = 0;
   const GenerationResult plain = TrajectoryGenerator(cfg).generate(pts, yaws, start, 0.0, field);

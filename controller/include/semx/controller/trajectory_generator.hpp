@@ -19,8 +19,10 @@
 #include "semx/controller/clearance.hpp"
 #include "semx/controller/controller_config.hpp"
 #include "semx/controller/distance_field.hpp"
+#include "semx/controller/path.hpp"
 #include "semx/controller/trajectory.hpp"
 #include "semx/controller/trajectory_optimizer.hpp"
+#include "semx/controller/vehicle_state.hpp"
 
 namespace semx::controller {
 
@@ -55,6 +57,10 @@ class TrajectoryGenerator {
   // point (yaws[0] = start.yaw). `max_speed` > 0 lowers the configured speed limit.
   GenerationResult generate(const std::vector<Eigen::Vector3d>& polyline, const std::vector<double>& yaws,
                             const StartState& start, double max_speed, const DistanceField& field) const;
+  // A path from the planner as the controller flies it (Controller, semx-controller-replay): from
+  // the vehicle's state along flight_polyline() (path.hpp), at most the path's max_speed. The
+  // path's start must already have been checked (check_path_start).
+  GenerationResult generate(const Path& path, const VehicleState& vehicle, const DistanceField& field) const;
 
   // The rule a new trajectory must meet (bound = half_size + margin); an optimised one also the
   // turned body's reach (clearance.turned_body). The fallback follows the planner's path exactly,
