@@ -6,6 +6,7 @@
 #include <bitset>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -456,6 +457,50 @@ TEST(Oracle, PathsKeepTheClearanceOnTheTrueMapAndGoAroundWalls) {
   }
   EXPECT_GT(length, (b - a).norm());
   EXPECT_LT(length, (b - a).norm() + 1.5);
+}
+
+// The live map knows everything but `unknown_own` of the T voxels only viewpoint 0 of the tour
+// sees, and none of those only viewpoint 1 sees: what the oracle flies to next from the start.
+size_t next_after_replan(double needed_share, size_t unknown_own) {
+  const SyntheticWorld world = tiny_world();
+  const SyntheticTruth truth(world);
+  PlanScene scene("oracle");
+  scene.config = tiny_config();
+  scene.config.oracle.needed_share = needed_share;
+  OracleStrategy oracle(scene.config);
+  oracle.set_truth(&truth);
+  EXPECT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
+  EXPECT_GE(oracle.tour().size(), 2u);
+  if (oracle.tour().size() < 2) return 0;
+  // What only viewpoint 0, or only viewpoint 1, sees of all the tour's viewpoints.
+  std::map<map::VoxelKey, int> seers;
+  for (size_t j = 0; j < oracle.tour().size(); ++j)
+    for (const map::VoxelKey& k : oracle.seen_by(j)) ++seers[k];
+  auto only = [&](size_t i) {
+    std::vector<map::VoxelKey> own;
+    for (const map::VoxelKey& k : oracle.seen_by(i))
+      if (seers[k] == 1) own.push_back(k);
+    return own;
+  };
+  const std::vector<map::VoxelKey> own0 = only(0), own1 = only(1);
+  EXPECT_GE(own0.size(), 20u) << "viewpoint 0 must show voxels no other does";
+  EXPECT_GE(own1.size(), 1u);
+  scene.grid = world.full_map();
+  for (size_t i = 0; i < std::min(unknown_own, own0.size()); ++i)
+    scene.grid.set_state(own0[i], map::VoxelState::kUnknown);
+  for (const map::VoxelKey& k : own1) scene.grid.set_state(k, map::VoxelState::kUnknown);
+  PlanContext ctx = scene.context(world.start());
+  const PlanOutcome o = oracle.plan(ctx);
+  EXPECT_TRUE(o.goal.valid) << o.reason;
+  return oracle.next_viewpoint();
+}
+
+TEST(Oracle, AViewpointWithAVoxelOrTwoOfItsShareLeftIsNotFlownBackTo) {
+  // In env3's process set one voxel of 158 sent the vehicle back 5 m, twice, to a viewpoint it
+  // had passed on a chain (docs/planner.md, "The known-map oracle").
+  EXPECT_EQ(next_after_replan(0.1, 1), 1u) << "one voxel of its share left: on to the next";
+  EXPECT_EQ(next_after_replan(0.0, 1), 0u) << "needed_share 0: any voxel left is flown to";
+  EXPECT_EQ(next_after_replan(0.1, 1000000), 0u) << "its share unknown: flown to";
 }
 
 TEST(Oracle, WithoutTheTruthItIsDoneAtOnceAndSaysWhy) {
