@@ -1334,8 +1334,7 @@ PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
       const OracleViewpoint& v = tour_[i];
       std::vector<Eigen::Vector3d> leg = truth_path(from, v.position);
       if (leg.empty() || path.size() + leg.size() > kMaxWaypoints) break;
-      double len = 0.0;
-      for (size_t k = 1; k < leg.size(); ++k) len += (leg[k] - leg[k - 1]).norm();
+      const double len = path_length(leg);
       std::vector<double> leg_yaws = interpolate_yaws(leg, from_yaw, v.yaw);
       hold_square(leg, leg_yaws);
       for (size_t k = 1; k < leg.size(); ++k) {

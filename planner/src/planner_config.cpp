@@ -195,6 +195,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("view_angles", fu.view_angles, 1, 3600);
   f.get("view_height_step", fu.view_height_step, 0.0, 100.0);
   f.get("far_rings", fu.far_rings);
+  f.get("approach", fu.approach);
   f.get("coverage_cells", fu.coverage_cells, 1, 100000);
   f.get("min_coverage", fu.min_coverage, 0.0, 1e9);
   f.get("min_view_distance", fu.min_view_distance, 0.0, 100.0);

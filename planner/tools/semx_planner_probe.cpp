@@ -17,8 +17,11 @@
 
 #include <octomap/OcTree.h>
 
+#include "semx/core/random.hpp"
 #include "semx/map/state_grid.hpp"
 #include "semx/planner/collision_checker.hpp"
+#include "semx/planner/frontier_tracker.hpp"
+#include "semx/planner/fuel_strategy.hpp"
 #include "semx/planner/grid_search.hpp"
 #include "semx/planner/planner_config.hpp"
 #include "semx/runtime/args.hpp"
@@ -61,6 +64,52 @@ struct Door {
 Eigen::Vector3d at(const Door& d, double along, double across, double z) {
   return d.axis == 'x' ? Eigen::Vector3d(d.x + along, d.y + across, z)
                        : Eigen::Vector3d(d.x + across, d.y + along, z);
+}
+
+// "X,Y,Z" (--fuel).
+bool parse_point(const std::string& s, Eigen::Vector3d& a) {
+  std::istringstream in(s);
+  char c;
+  return static_cast<bool>(in >> a.x() >> c >> a.y() >> c >> a.z());
+}
+
+// One FUEL-family plan from `at` on the map, as the planner's first cycle on it would make it
+// (fresh clusters, no blacklist): its goal or why there is none, then every frontier cluster
+// with its viewpoints. Answers "why did FUEL find nothing to fly to here".
+void probe_fuel(const map::StateGrid& grid, const planner::PlannerConfig& config, const Eigen::Vector3d& at) {
+  planner::FrontierTracker frontiers(1.0);
+  frontiers.reset(grid);
+  planner::FuelStrategy fuel(config);
+  core::SplitMixRng rng(config.seed);
+  planner::CycleCounters counters;
+  std::vector<planner::SemanticRegion> regions;
+  planner::PlanContext ctx;
+  ctx.grid = &grid;
+  ctx.pose.position = at;
+  ctx.regions = &regions;
+  ctx.frontiers = &frontiers;
+  ctx.cycle = 1;
+  ctx.rng = &rng;
+  ctx.counters = &counters;
+  ctx.need_goal = true;
+  const planner::PlanOutcome o = fuel.plan(ctx);
+  std::printf("fuel from (%.2f %.2f %.2f): %zu frontier voxels, %zu clusters\n", at.x(), at.y(), at.z(),
+              frontiers.size(), fuel.clusters().clusters().size());
+  if (o.goal.valid)
+    std::printf("goal (%.2f %.2f %.2f) yaw %.2f, %zu waypoints\n", o.goal.position.x(), o.goal.position.y(),
+                o.goal.position.z(), o.goal.yaw, o.goal.waypoints.size());
+  else
+    std::printf("no goal: %s\n", o.reason.c_str());
+  for (const auto& [id, c] : fuel.clusters().clusters()) {
+    const std::vector<planner::Viewpoint>& views = fuel.viewpoints(id);
+    std::printf("  cluster %lld: %zu voxels, mean (%.2f %.2f %.2f), %zu viewpoints",
+                static_cast<long long>(id), c.voxels.size(), c.mean.x(), c.mean.y(), c.mean.z(),
+                views.size());
+    if (!views.empty())
+      std::printf(", best (%.2f %.2f %.2f) covers %.0f", views.front().position.x(),
+                  views.front().position.y(), views.front().position.z(), views.front().coverage);
+    std::printf("\n");
+  }
 }
 
 // "AX,AY,AZ,BX,BY,BZ" (--edge, --path).
@@ -176,17 +225,20 @@ void probe(const map::StateGrid& grid, const planner::CollisionChecker& checker,
 int main(int argc, char** argv) {
   return runtime::run_main("semx-planner-probe", [&] {
     std::string map_file, config_file;
-    std::vector<std::string> doors, overrides, edges, paths;
+    std::vector<std::string> doors, overrides, edges, paths, fuels;
     runtime::ArgParser p("semx-planner-probe",
                          "Prints the planner's collision checks around doorways of a run's map.bt.");
     p.positional("MAP", "an OctoMap .bt (a run folder's map.bt, or semx-map-replay's)", &map_file)
         .option("config", "FILE", "planner YAML", &config_file)
         .repeated("set", "KEY=VALUE", "override one planner config key", &overrides)
         .repeated("door", "X,Y,AXIS", "a doorway: centre and the axis its wall runs along", &doors)
-        .repeated("edge", "AX,AY,AZ,BX,BY,BZ", "one edge: what each check says about it and its ends",
-                  &edges)
-        .repeated("path", "AX,AY,AZ,BX,BY,BZ", "FUEL's grid search from A to B: the coarse distance and the path",
-                  &paths);
+        .repeated("edge", "AX,AY,AZ,BX,BY,BZ", "one edge: what each check says about it and its ends", &edges)
+        .repeated("path", "AX,AY,AZ,BX,BY,BZ",
+                  "FUEL's grid search from A to B: the coarse distance and the path", &paths)
+        .repeated(
+            "fuel", "X,Y,Z",
+            "one FUEL-family plan from the vehicle at X,Y,Z: its goal, every cluster and its viewpoints",
+            &fuels);
     if (!p.parse(argc, argv)) return 0;
     const auto config = runtime::load_config<planner::PlannerConfig>(config_file, overrides);
     map::StateGrid grid(0.1);
@@ -250,7 +302,15 @@ int main(int argc, char** argv) {
       }
       for (const Eigen::Vector3d& q : out) std::printf("  (%.2f %.2f %.2f)\n", q.x(), q.y(), q.z());
     }
-    if ((!edges.empty() || !paths.empty()) && list.empty()) return 0;
+    for (const std::string& s : fuels) {
+      Eigen::Vector3d a;
+      if (!parse_point(s, a)) {
+        std::cerr << "bad --fuel " << s << "\n";
+        return 2;
+      }
+      probe_fuel(grid, config, a);
+    }
+    if ((!edges.empty() || !paths.empty() || !fuels.empty()) && list.empty()) return 0;
     if (list.empty()) {
       list = {{3.5, 5.5, 'x'}, {9.0, 5.5, 'x'}, {12.25, 5.5, 'x'}, {14.75, 5.5, 'x'},
               {2.5, 7.0, 'x'}, {7.7, 7.0, 'x'}, {12.5, 7.0, 'x'},  {7.0, 2.0, 'y'}};

@@ -102,6 +102,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.view_angles);
   SAME(fuel.view_height_step);
   SAME(fuel.far_rings);
+  SAME(fuel.approach);
   SAME(fuel.coverage_cells);
   SAME(fuel.min_coverage);
   SAME(fuel.min_view_distance);

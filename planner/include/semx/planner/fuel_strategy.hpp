@@ -148,6 +148,10 @@ class FuelStrategy : public Strategy {
 
   // fuel.square_clearance: the interior waypoints near an obstacle hold the direction of travel.
   void square_near_obstacles(const std::vector<Eigen::Vector3d>& waypoints, std::vector<double>& yaws) const;
+  // A path as far along the coarse path `guide` (vehicle to view) as A* reaches, at least
+  // 1 m from the vehicle; `yaw` looks along the guide from its end. False when none is.
+  bool approach(const std::vector<Eigen::Vector3d>& guide, CycleCounters* counters,
+                std::vector<Eigen::Vector3d>& out, double& yaw);
 
   PlannerConfig config_;
   CollisionChecker checker_;
@@ -169,6 +173,10 @@ class FuelStrategy : public Strategy {
   // does not hold DONE back.
   std::vector<std::pair<Eigen::Vector3d, int>> strikes_;
   static constexpr int kStrikes = 2;
+  // Views without a path to them, with how many times (approach()): the first kApproaches times
+  // the vehicle flies toward them, then they are skipped.
+  std::vector<std::pair<Eigen::Vector3d, int>> approaches_;
+  static constexpr int kApproaches = 3;
   // Places of targets given up before they were reached (another target chosen), with how many
   // times. Once only small clusters are left (none of FUEL's size), a place given up kCommit
   // times is flown until reached (or until its view is no longer free) when it is chosen again,

@@ -390,6 +390,10 @@ struct FuelConfig {
   // farther out, in view_radius steps, to the camera's range, before the planner ends (not in
   // FUEL).
   bool far_rings = true;
+  // No A* path to the tour's next view while the coarse lattice has one: fly as far along the
+  // coarse path as A* reaches, looking along it, at most three times per view, before it is
+  // skipped (FuelStrategy::approach).
+  bool approach = true;
   // At most this many of a cluster's voxels (spread over it) are tested for visibility; a
   // candidate's coverage is the share of them it sees times the cluster's voxels (FUEL
   // down-samples its cells by 3 per axis).

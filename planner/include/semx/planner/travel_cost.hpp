@@ -8,7 +8,9 @@
 // CostConfig::min_time so that the node under the vehicle cannot score infinitely.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
+#include <vector>
 
 #include "semx/core/angles.hpp"
 #include "semx/planner/planner_config.hpp"
@@ -24,6 +26,13 @@ inline double travel_time(double distance, double yaw_change, const CostConfig& 
 
 inline double travel_time(double distance, double from_yaw, double to_yaw, const CostConfig& c) {
   return travel_time(distance, core::yaw_distance(from_yaw, to_yaw), c);
+}
+
+// The length of a polyline (m).
+inline double path_length(const std::vector<Eigen::Vector3d>& path) {
+  double length = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
+  return length;
 }
 
 inline double node_score(double gain, double reward, double time) { return (gain + reward) / time; }
