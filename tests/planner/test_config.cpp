@@ -171,6 +171,10 @@ TEST(PlannerConfig, TheShippedAblationsLoad) {
   EXPECT_FALSE(tour.fuel.latency_gain);
   const PlannerConfig gain = load_config<PlannerConfig>(dir + "fuel_latency_gain.yaml");
   EXPECT_TRUE(gain.fuel.latency_tour && gain.fuel.latency_gain);
+  EXPECT_TRUE(gain.semantic_fuel.object_pockets);
+  const PlannerConfig no_pockets = load_config<PlannerConfig>(dir + "fuel_latency_gain_no_pockets.yaml");
+  EXPECT_TRUE(no_pockets.fuel.latency_tour && no_pockets.fuel.latency_gain);
+  EXPECT_FALSE(no_pockets.semantic_fuel.object_pockets);
   // Every file there is one a bench can be given (`--arg planner_config=...`).
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
@@ -178,7 +182,7 @@ TEST(PlannerConfig, TheShippedAblationsLoad) {
     ++files;
     EXPECT_NO_THROW(load_config<PlannerConfig>(entry.path().string())) << entry.path();
   }
-  EXPECT_GE(files, 7);  // the seven read above, at least
+  EXPECT_GE(files, 8);  // the eight read above, at least
 }
 
 TEST(PlannerConfig, OverridesAndErrors) {
