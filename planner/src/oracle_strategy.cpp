@@ -1296,19 +1296,18 @@ PlanOutcome OracleStrategy::plan(PlanContext& ctx) {
     attempts_ = 0;
   };
   // Whether viewpoint i still has something to show that no later viewpoint of the tour would:
-  // T voxels it sees, unknown in the live map, that only it (of those not flown) sees, at least
-  // oracle.needed_share of all those only it sees.
+  // oracle.needed_voxels T voxels it sees, unknown in the live map, that only it (of those not
+  // flown) sees.
   auto needed = [&](size_t i) {
     if (!ctx.grid) return true;
     map::StateGrid::Reader r(*ctx.grid);
-    int64_t own = 0, unknown = 0;
-    for (int32_t e : tour_elements_[i]) {
-      if (holders_[static_cast<size_t>(e)] != 1) continue;
-      ++own;
-      unknown += r.state(m.key_of(m.targets[static_cast<size_t>(e)])) == map::VoxelState::kUnknown;
-    }
-    return unknown > 0 &&
-           static_cast<double>(unknown) >= config_.oracle.needed_share * static_cast<double>(own);
+    int unknown = 0;
+    for (int32_t e : tour_elements_[i])
+      if (holders_[static_cast<size_t>(e)] == 1 &&
+          r.state(m.key_of(m.targets[static_cast<size_t>(e)])) == map::VoxelState::kUnknown &&
+          ++unknown >= config_.oracle.needed_voxels)
+        return true;
+    return false;
   };
   if (next_ < tour_.size() && attempts_ > 0 && chain_end_ >= next_ && chain_end_ < tour_.size() &&
       near(tour_[chain_end_]))

@@ -461,12 +461,12 @@ TEST(Oracle, PathsKeepTheClearanceOnTheTrueMapAndGoAroundWalls) {
 
 // The live map knows everything but `unknown_own` of the T voxels only viewpoint 0 of the tour
 // sees, and none of those only viewpoint 1 sees: what the oracle flies to next from the start.
-size_t next_after_replan(double needed_share, size_t unknown_own) {
+size_t next_after_replan(int needed_voxels, size_t unknown_own) {
   const SyntheticWorld world = tiny_world();
   const SyntheticTruth truth(world);
   PlanScene scene("oracle");
   scene.config = tiny_config();
-  scene.config.oracle.needed_share = needed_share;
+  scene.config.oracle.needed_voxels = needed_voxels;
   OracleStrategy oracle(scene.config);
   oracle.set_truth(&truth);
   EXPECT_TRUE(oracle.prepare(world.start(), 0.0)) << oracle.summary().error;
@@ -498,9 +498,11 @@ size_t next_after_replan(double needed_share, size_t unknown_own) {
 TEST(Oracle, AViewpointWithAVoxelOrTwoOfItsShareLeftIsNotFlownBackTo) {
   // In env3's process set one voxel of 158 sent the vehicle back 5 m, twice, to a viewpoint it
   // had passed on a chain (docs/planner.md, "The known-map oracle").
-  EXPECT_EQ(next_after_replan(0.1, 1), 1u) << "one voxel of its share left: on to the next";
-  EXPECT_EQ(next_after_replan(0.0, 1), 0u) << "needed_share 0: any voxel left is flown to";
-  EXPECT_EQ(next_after_replan(0.1, 1000000), 0u) << "its share unknown: flown to";
+  EXPECT_EQ(next_after_replan(10, 1), 1u) << "one voxel of its share left: on to the next";
+  EXPECT_EQ(next_after_replan(10, 9), 1u) << "nine: on to the next";
+  EXPECT_EQ(next_after_replan(10, 10), 0u) << "ten: flown to";
+  EXPECT_EQ(next_after_replan(1, 1), 0u) << "needed_voxels 1: any voxel left is flown to";
+  EXPECT_EQ(next_after_replan(10, 1000000), 0u) << "its share unknown: flown to";
 }
 
 TEST(Oracle, WithoutTheTruthItIsDoneAtOnceAndSaysWhy) {
