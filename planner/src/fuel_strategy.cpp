@@ -615,15 +615,11 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
       // far room struck off from the first room, which the vehicle had not left.
       double yaw = goal_view.yaw;
       if (approach(guide, ctx.counters, waypoints, yaw)) {
-        ctx.counters->connect_ms += pw.ms();
         g.position = waypoints.back();
         g.yaw = yaw;
         g.cost = travel_time(path_length(waypoints), vehicle_yaw_, yaw, cost);
         g.score = g.gain / g.cost;
-        g.waypoints = split_long_segments(waypoints, 9.0);
-        g.yaws = turn_early_yaws(g.waypoints, vehicle_yaw_, g.yaw, cost.velocity, cost.yaw_rate);
-        square_near_obstacles(g.waypoints, g.yaws);
-        return p;
+        found = true;
       }
     }
     ctx.counters->connect_ms += pw.ms();
