@@ -66,11 +66,17 @@ Eigen::Vector3d at(const Door& d, double along, double across, double z) {
                        : Eigen::Vector3d(d.x + across, d.y + along, z);
 }
 
+// "X,Y,Z" from `in`, and a separator after it when `more`.
+bool read_point(std::istream& in, Eigen::Vector3d& a, bool more) {
+  char c;
+  if (!(in >> a.x() >> c >> a.y() >> c >> a.z())) return false;
+  return !more || static_cast<bool>(in >> c);
+}
+
 // "X,Y,Z" (--fuel).
 bool parse_point(const std::string& s, Eigen::Vector3d& a) {
   std::istringstream in(s);
-  char c;
-  return static_cast<bool>(in >> a.x() >> c >> a.y() >> c >> a.z());
+  return read_point(in, a, false);
 }
 
 // One FUEL-family plan from `at` on the map, as the planner's first cycle on it would make it
@@ -115,8 +121,7 @@ void probe_fuel(const map::StateGrid& grid, const planner::PlannerConfig& config
 // "AX,AY,AZ,BX,BY,BZ" (--edge, --path).
 bool parse_points(const std::string& s, Eigen::Vector3d& a, Eigen::Vector3d& b) {
   std::istringstream in(s);
-  char c;
-  return static_cast<bool>(in >> a.x() >> c >> a.y() >> c >> a.z() >> c >> b.x() >> c >> b.y() >> c >> b.z());
+  return read_point(in, a, true) && read_point(in, b, false);
 }
 
 void probe(const map::StateGrid& grid, const planner::CollisionChecker& checker, const Door& d) {

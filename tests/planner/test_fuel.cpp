@@ -993,11 +993,6 @@ TEST(Fuel, APlaceReachedAgainAfterItsSkipIsSkippedForGood) {
   }
 }
 
-// A view the field reaches and A* does not: the field's cells are lenient (a doorway is never lost
-// between two cell centres) where A* keeps door_clearance, and a 0.6 m gap passes the one and not
-// the other. While recovering, the second failed search at a place bans it for good, so it no
-// longer holds DONE back (env3 with noise: such views were skipped and freed every 21 cycles
-// for 700 s); while exploring, a failure only skips the view, as before.
 // Two rooms joined by a 0.6 m gap in the wall at x = 4: the coarse lattice passes it, A* with the
 // passage clearance does not.
 SyntheticWorld narrow_gap_world() {
@@ -1046,6 +1041,11 @@ TEST(Fuel, AViewOnlyTheCoarseLatticeReachesIsApproachedBeforeItIsSkipped) {
   }
 }
 
+// A view the field reaches and A* does not: the field's cells are lenient (a doorway is never lost
+// between two cell centres) where A* keeps door_clearance, and a 0.6 m gap passes the one and not
+// the other. While recovering, the second failed search at a place bans it for good, so it no
+// longer holds DONE back (env3 with noise: such views were skipped and freed every 21 cycles
+// for 700 s); while exploring, a failure only skips the view, as before.
 TEST(Fuel, AViewNoPathReachesIsSkippedForGoodAtItsSecondFailureWhileRecovering) {
   const SyntheticWorld w = narrow_gap_world();
   const Eigen::Vector3d at(1.6, 2.0, 1.2);
