@@ -38,6 +38,8 @@ void load(runtime::ConfigMap& m, ControllerConfig& c) {
   t.get("knot_interval", c.trajectory.knot_interval, 0.02, 2.0);
   t.get("fallback_speed_factor", c.trajectory.fallback_speed_factor, 0.05, 1.0);
   t.get("max_deviation", c.trajectory.max_deviation, 0.0, 100.0);
+  t.get("slow_zone_radius", c.trajectory.slow_zone_radius, 0.0, 100.0);
+  t.get("slow_zone_tries", c.trajectory.slow_zone_tries, 0, 20);
 
   auto o = m.child("optimizer");
   o.get("max_iterations", c.optimizer.max_iterations, 0, 100000);

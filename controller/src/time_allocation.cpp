@@ -13,7 +13,8 @@ double TimedPolyline::corner_speed(double angle, double max_speed, double max_ac
 }
 
 TimedPolyline::TimedPolyline(std::vector<Eigen::Vector3d> points, double start_speed, double max_speed,
-                             double max_acceleration, double knot_interval)
+                             double max_acceleration, double knot_interval,
+                             const std::vector<double>& segment_speed)
     : points_(std::move(points)), a_(max_acceleration) {
   const std::size_t n = points_.size();
   point_times_.assign(n, 0.0);
@@ -32,9 +33,14 @@ TimedPolyline::TimedPolyline(std::vector<Eigen::Vector3d> points, double start_s
   std::vector<double> v(n, max_speed);
   v.front() = std::clamp(start_speed, 0.0, max_speed);
   v.back() = 0.0;
+  const bool capped = segment_speed.size() == n - 1;
+  auto cap = [&](std::size_t i) {
+    return capped ? std::clamp(segment_speed[i], 1e-3, max_speed) : max_speed;
+  };
   for (std::size_t i = 1; i + 1 < n; ++i) {
     const double c = std::clamp(segments_[i - 1].dir.dot(segments_[i].dir), -1.0, 1.0);
-    v[i] = corner_speed(std::acos(c), max_speed, max_acceleration, knot_interval);
+    v[i] = std::min(
+        {corner_speed(std::acos(c), max_speed, max_acceleration, knot_interval), cap(i - 1), cap(i)});
   }
   for (std::size_t i = 0; i + 1 < n; ++i) {
     v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2 * a_ * segments_[i].length));
@@ -54,7 +60,7 @@ TimedPolyline::TimedPolyline(std::vector<Eigen::Vector3d> points, double start_s
     const double reach = std::sqrt(std::max(0.0, s.v0 * s.v0 - 2 * a_ * s.length));
     if (reach > s.v1) s.v1 = reach;
     v[i + 1] = s.v1;
-    s.vp = std::min(max_speed, std::sqrt(0.5 * (2 * a_ * s.length + s.v0 * s.v0 + s.v1 * s.v1)));
+    s.vp = std::min(cap(i), std::sqrt(0.5 * (2 * a_ * s.length + s.v0 * s.v0 + s.v1 * s.v1)));
     s.vp = std::max({s.vp, s.v0, s.v1});
     const double d1 = (s.vp * s.vp - s.v0 * s.v0) / (2 * a_);
     const double d3 = (s.vp * s.vp - s.v1 * s.v1) / (2 * a_);

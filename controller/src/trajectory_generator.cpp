@@ -155,11 +155,12 @@ Eigen::Vector3d TrajectoryGenerator::start_velocity(const StartState& start, dou
 
 PositionSpline TrajectoryGenerator::initial_spline(const std::vector<Eigen::Vector3d>& polyline,
                                                    const StartState& start, double v_max,
-                                                   std::vector<double>* point_times, double v_start) const {
+                                                   std::vector<double>* point_times, double v_start,
+                                                   const std::vector<double>& segment_speed) const {
   const double dt = config_.trajectory.knot_interval;
   const Eigen::Vector3d v0 = start_velocity(start, std::max(v_max, v_start));
   const double along = polyline.size() > 1 ? v0.dot((polyline[1] - polyline[0]).normalized()) : 0.0;
-  const TimedPolyline timed(polyline, along, v_max, config_.limits.max_acceleration, dt);
+  const TimedPolyline timed(polyline, along, v_max, config_.limits.max_acceleration, dt, segment_speed);
   if (point_times) *point_times = timed.point_times();
   const int m = std::max(2, static_cast<int>(std::ceil(timed.duration() / dt)));
   // Control point i sits near the curve at time (i-1)·dt. The first three give the start
@@ -191,16 +192,73 @@ Eigen::Vector3d TrajectoryGenerator::nearest_on_path(const Eigen::Vector3d& p,
 }
 
 double TrajectoryGenerator::deviation(const PositionSpline& curve,
-                                      const std::vector<Eigen::Vector3d>& polyline) {
+                                      const std::vector<Eigen::Vector3d>& polyline, Eigen::Vector3d* where) {
   if (polyline.empty()) return 0.0;
   const double duration = curve.duration();
   const int n = std::max(1, static_cast<int>(std::ceil(duration / kDeviationStep)));
   double worst = 0.0;
   for (int i = 0; i <= n; ++i) {
     const Eigen::Vector3d p = curve.evaluate(duration * i / n, 0);
-    worst = std::max(worst, (nearest_on_path(p, polyline) - p).norm());
+    const double off = (nearest_on_path(p, polyline) - p).norm();
+    if (off > worst || i == 0) {
+      worst = std::max(worst, off);
+      if (where) *where = p;
+    }
   }
   return worst;
+}
+
+SlowZones::Split SlowZones::split(const std::vector<Eigen::Vector3d>& polyline,
+                                  const std::vector<double>& yaws, double v_slow, double v_fast) const {
+  Split out;
+  if (polyline.empty()) return out;
+  out.points.push_back(polyline.front());
+  out.yaws.push_back(yaws.empty() ? 0.0 : yaws.front());
+  auto inside = [&](const Eigen::Vector3d& p) {
+    return std::any_of(zones.begin(), zones.end(),
+                       [&](const Zone& z) { return (p - z.centre).norm() < z.radius; });
+  };
+  for (std::size_t k = 0; k + 1 < polyline.size(); ++k) {
+    const Eigen::Vector3d a = polyline[k], d = polyline[k + 1] - a;
+    const double len = d.norm();
+    const double ya = k < yaws.size() ? yaws[k] : out.yaws.back();
+    const double yb = k + 1 < yaws.size() ? yaws[k + 1] : ya;
+    // Where the segment enters or leaves a zone: |a + t d - c| = r.
+    std::vector<double> cuts;
+    const double dd = d.squaredNorm();
+    for (const Zone& z : zones) {
+      if (dd <= 0) break;
+      const Eigen::Vector3d w = a - z.centre;
+      const double b = w.dot(d), c = w.squaredNorm() - z.radius * z.radius, disc = b * b - dd * c;
+      if (disc <= 0) continue;
+      for (double t : {(-b - std::sqrt(disc)) / dd, (-b + std::sqrt(disc)) / dd})
+        if (t * len > kMinPiece && (1 - t) * len > kMinPiece) cuts.push_back(t);
+    }
+    std::sort(cuts.begin(), cuts.end());
+    cuts.push_back(1.0);
+    double t0 = 0.0;
+    for (double t : cuts) {
+      if ((t - t0) * len <= kMinPiece && t < 1.0) continue;
+      out.speed.push_back(inside(a + 0.5 * (t0 + t) * d) ? v_slow : v_fast);
+      out.points.push_back(t < 1.0 ? Eigen::Vector3d(a + t * d) : polyline[k + 1]);
+      // The turn to the next waypoint's heading spread over the pieces by length.
+      out.yaws.push_back(ya + t * (yb - ya));
+      t0 = t;
+    }
+  }
+  return out;
+}
+
+bool SlowZones::add(const Eigen::Vector3d& p, double radius) {
+  for (Zone& z : zones) {
+    // The same trouble again: its zone was too small.
+    if ((p - z.centre).norm() < 0.5 * z.radius) {
+      z.radius *= 1.5;
+      return false;
+    }
+  }
+  zones.push_back(Zone{p, radius});
+  return true;
 }
 
 GenerationResult TrajectoryGenerator::generate(const Path& path, const VehicleState& vehicle,
@@ -233,45 +291,74 @@ GenerationResult TrajectoryGenerator::generate(const std::vector<Eigen::Vector3d
   if (config_.optimizer.max_iterations > 0) {
     // The deviation is measured from where the fallback would fly, braking ray included.
     const std::vector<Eigen::Vector3d> route = fallback_route(polyline, v0, a_max, dt);
-    // One optimised curve cruising at `cruise` (starting at the vehicle's velocity); on failure,
-    // says why in `attempt` and `cause`.
+    // One optimised curve cruising at `cruise` (starting at the vehicle's velocity), or along
+    // `split` at its pieces' speeds; on failure, says why in `attempt` and `cause` and where in
+    // `trouble`.
     std::string attempt;
     FallbackCause cause = FallbackCause::kNone;
-    const auto optimised = [&](double cruise) {
+    Eigen::Vector3d trouble = Eigen::Vector3d::Zero();
+    const auto optimised = [&](double cruise, const SlowZones::Split* split) {
       std::vector<double> times;
       Trajectory smooth;
       smooth.optimized = true;
-      smooth.position = initial_spline(polyline, start, cruise, &times, v_max);
+      smooth.position = split ? initial_spline(split->points, start, v_max, &times, v_max, split->speed)
+                              : initial_spline(polyline, start, cruise, &times, v_max);
       result.optimizer = optimizer_.optimize(smooth.position, field, v_max, a_max,
                                              config_.clearance.bound() + config_.optimizer.target_margin);
       if (result.optimizer.failed) {
         attempt = "optimiser failed (" + result.optimizer.message + ")";
         cause = FallbackCause::kOptimizerFailed;
-      } else if (const double off = deviation(smooth.position, route);
+      } else if (const double off = deviation(smooth.position, route, &trouble);
                  off > config_.trajectory.max_deviation) {
         std::ostringstream s;
         s << "optimised trajectory strays " << std::fixed << std::setprecision(2) << off
           << " m from the path";
         attempt = s.str();
         cause = FallbackCause::kStrays;
-      } else if (finish(smooth, times, yaws, v_max, field, result)) {
+      } else if (finish(smooth, times, split ? split->yaws : yaws, v_max, field, result)) {
         result.ok = true;
         result.trajectory = std::move(smooth);
         return true;
       } else {
         attempt = "optimised trajectory too close to an obstacle: " + describe(result.clearance);
         cause = FallbackCause::kTooClose;
+        trouble = result.clearance.violation_point;
       }
       return false;
     };
-    if (optimised(v_max)) return result;
+    if (optimised(v_max, nullptr)) return result;
     // The full-speed attempt says why the vehicle does not fly it.
     why = attempt;
     result.cause = cause;
+    // The trouble is usually one place (a doorway the turned body passes only square, a corner
+    // cut too wide): the curve is optimised again at the fallback's cruise speed within
+    // slow_zone_radius of it, at full speed elsewhere. Slowing the whole path for it had flown
+    // a 27 s tour leg across env3 at half speed for one door.
+    const TrajectoryConfig& tc = config_.trajectory;
+    if (v_fallback < v_max && cause != FallbackCause::kOptimizerFailed && tc.slow_zone_radius > 0) {
+      SlowZones zones;
+      for (int k = 0; k < tc.slow_zone_tries; ++k) {
+        zones.add(trouble, tc.slow_zone_radius);
+        const SlowZones::Split split = zones.split(polyline, yaws, v_fallback, v_max);
+        if (optimised(v_max, &split)) {
+          result.slowed = true;
+          result.slow_zones = static_cast<int>(zones.zones.size());
+          std::ostringstream s;
+          const SlowZones::Zone& z = zones.zones.back();
+          s << "optimised at " << std::setprecision(3) << v_fallback << " m/s within " << z.radius << " m of "
+            << zones.zones.size() << " place(s), the last (" << z.centre.x() << ", " << z.centre.y() << ", "
+            << z.centre.z() << "): " << why;
+          result.reason = s.str();
+          return result;
+        }
+        if (cause == FallbackCause::kOptimizerFailed) break;
+      }
+    }
     // Tried once more at the fallback's cruise speed: a corner is cut by about v²/a, so a quarter
     // as far at half the speed, and the curve still does not stop at every waypoint as the
     // fallback does.
-    if (v_fallback < v_max && result.cause != FallbackCause::kOptimizerFailed && optimised(v_fallback)) {
+    if (v_fallback < v_max && result.cause != FallbackCause::kOptimizerFailed &&
+        optimised(v_fallback, nullptr)) {
       result.slowed = true;
       std::ostringstream s;
       s << "optimised at " << std::setprecision(3) << v_fallback << " m/s: " << why;

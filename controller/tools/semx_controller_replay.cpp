@@ -61,8 +61,8 @@ int main(int argc, char** argv) {
                    log_path.c_str());
       return 1;
     }
-    int optimised = 0, slowed = 0, fallbacks = 0, none = 0, repaired = 0;
-    double fallback_seconds = 0.0;
+    int optimised = 0, slowed = 0, slowed_near = 0, fallbacks = 0, none = 0, repaired = 0;
+    double fallback_seconds = 0.0, slowed_seconds = 0.0;
     for (const ReplayedPath& path : r.paths) {
       const GenerationResult& g = path.generation;
       repaired += g.repaired_headings;
@@ -73,6 +73,8 @@ int main(int argc, char** argv) {
         ++none;
       } else if (g.slowed) {
         ++slowed;
+        slowed_near += g.slow_zones > 0;
+        slowed_seconds += g.trajectory.duration();
       } else {
         ++fallbacks;
         fallback_seconds += g.trajectory.duration();
@@ -84,10 +86,11 @@ int main(int argc, char** argv) {
                     g.ok ? g.trajectory.duration() : 0.0, g.reason.empty() ? kind(g) : g.reason.c_str());
     }
     std::printf(
-        "paths: %zu\noptimised: %d\nslowed: %d\nfallbacks: %d (%.1f s of flight)\nno trajectory: %d\n"
+        "paths: %zu\noptimised: %d\nslowed: %d (%d only near where the full-speed curve failed; %.1f s of "
+        "flight)\nfallbacks: %d (%.1f s of flight)\nno trajectory: %d\n"
         "repaired headings: %d\nskipped (no map or vehicle yet, or the start too far): %d\nmalformed: %d\n",
-        r.paths.size(), optimised, slowed, fallbacks, fallback_seconds, none, repaired, r.skipped,
-        r.malformed);
+        r.paths.size(), optimised, slowed, slowed_near, slowed_seconds, fallbacks, fallback_seconds, none,
+        repaired, r.skipped, r.malformed);
     if (!r.session.empty()) std::printf("%s\n", r.session.c_str());
     return 0;
   });

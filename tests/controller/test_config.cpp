@@ -27,6 +27,8 @@ TEST(ControllerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(clearance.outside_is_obstacle);
   SAME(trajectory.knot_interval);
   SAME(trajectory.fallback_speed_factor);
+  SAME(trajectory.slow_zone_radius);
+  SAME(trajectory.slow_zone_tries);
   SAME(clearance.half_height);
   SAME(clearance.footprint_margin);
   SAME(clearance.turned_body);

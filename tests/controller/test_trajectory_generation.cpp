@@ -392,6 +392,69 @@ TEST(TrajectoryGeneration, AnOptimisedCurveThatStraysIsSlowedThenTakesTheFallbac
   EXPECT_LT(slowed.trajectory.duration(), strict.trajectory.duration()) << "the slowed curve does not stop";
 }
 
+TEST(SlowZones, APolylineIsCutWhereItEntersAndLeavesAZone) {
+  SlowZones z;
+  EXPECT_TRUE(z.add({4, 0, 1}, 1.0));
+  // A place within half a radius of a zone's centre grows that zone instead.
+  EXPECT_FALSE(z.add({4.3, 0, 1}, 1.0));
+  ASSERT_EQ(z.zones.size(), 1u);
+  EXPECT_DOUBLE_EQ(z.zones[0].radius, 1.5);
+  const SlowZones::Split s = z.split({{0, 0, 1}, {8, 0, 1}, {8, 4, 1}}, {0.0, 1.0, 2.0}, 0.5, 1.0);
+  // The first leg in three pieces (x = 2.5 and 5.5), the second whole.
+  ASSERT_EQ(s.points.size(), 5u);
+  ASSERT_EQ(s.speed.size(), 4u);
+  EXPECT_NEAR(s.points[1].x(), 2.5, 1e-9);
+  EXPECT_NEAR(s.points[2].x(), 5.5, 1e-9);
+  EXPECT_EQ(s.points[3], Eigen::Vector3d(8, 0, 1));
+  EXPECT_EQ(s.speed, (std::vector<double>{1.0, 0.5, 1.0, 1.0}));
+  // Headings keep their waypoints' and turn by length in between.
+  EXPECT_NEAR(s.yaws[1], 2.5 / 8, 1e-9);
+  EXPECT_NEAR(s.yaws[2], 5.5 / 8, 1e-9);
+  EXPECT_EQ(s.yaws[3], 1.0);
+  EXPECT_EQ(s.yaws[4], 2.0);
+  // No zone: the polyline as it is, at full speed.
+  const SlowZones::Split none = SlowZones{}.split({{0, 0, 1}, {8, 0, 1}}, {0.0, 1.0}, 0.5, 1.0);
+  EXPECT_EQ(none.points.size(), 2u);
+  EXPECT_EQ(none.speed, (std::vector<double>{1.0}));
+}
+
+TEST(TrajectoryGeneration, AFailingCornerOfALongPathIsSlowedThereOnly) {
+  // Eight metres, a right angle, eight metres: the full-speed curve cuts the corner past a
+  // max_deviation made narrower than its cut. Slowed near the corner only, the long legs are flown
+  // at full speed; slowed along the whole path (slow_zone_radius 0), at half speed.
+  const std::vector<Eigen::Vector3d> path = {{0, 0, 1}, {8, 0, 1}, {8, 8, 1}};
+  const std::vector<double> yaws = {0, 0, M_PI / 2};
+  ControllerConfig cfg;
+  const GenerationResult fast =
+      TrajectoryGenerator(cfg).generate(path, yaws, at_rest(path[0]), 0.0, FreeField());
+  ASSERT_TRUE(fast.ok && fast.trajectory.optimized && !fast.slowed) << fast.reason;
+  // 0.6 of its cut: the whole path at half speed cuts 0.51 of it, the corner alone slowed 0.39.
+  cfg.trajectory.max_deviation = 0.6 * TrajectoryGenerator::deviation(fast.trajectory.position, path);
+  const GenerationResult local =
+      TrajectoryGenerator(cfg).generate(path, yaws, at_rest(path[0]), 0.0, FreeField());
+  ASSERT_TRUE(local.ok) << local.reason;
+  EXPECT_TRUE(local.trajectory.optimized);
+  EXPECT_TRUE(local.slowed);
+  EXPECT_EQ(local.slow_zones, 1) << local.reason;
+  EXPECT_NE(local.reason.find("strays"), std::string::npos) << local.reason;
+  EXPECT_LE(TrajectoryGenerator::deviation(local.trajectory.position, path), cfg.trajectory.max_deviation);
+  cfg.trajectory.slow_zone_radius = 0.0;
+  const GenerationResult whole =
+      TrajectoryGenerator(cfg).generate(path, yaws, at_rest(path[0]), 0.0, FreeField());
+  ASSERT_TRUE(whole.ok && whole.trajectory.optimized && whole.slowed) << whole.reason;
+  EXPECT_EQ(whole.slow_zones, 0);
+  // Fastest speed on the first leg, away from the corner.
+  auto top_speed = [](const Trajectory& t) {
+    double v = 0;
+    for (double s = 0; s < t.duration(); s += 0.01)
+      if (t.position_at(s).x() < 5.0) v = std::max(v, t.position.evaluate(s, 1).norm());
+    return v;
+  };
+  EXPECT_GT(top_speed(local.trajectory), 0.9);
+  EXPECT_LT(top_speed(whole.trajectory), 0.8);
+  EXPECT_LT(local.trajectory.duration(), 0.75 * whole.trajectory.duration());
+}
+
 TEST(TrajectoryGeneration, TheFidelityTermKeepsTheFullSpeedCurveOnAZigzagPath) {
   // Three 1.5 m legs at right angles: smoothness alone rounds the zigzag 0.46 m off the path, past
   // max_deviation, and the curve is flown at half speed. Control points pay for offsets beyond
@@ -408,6 +471,7 @@ TEST(TrajectoryGeneration, TheFidelityTermKeepsTheFullSpeedCurveOnAZigzagPath) {
   EXPECT_LE(TrajectoryGenerator::deviation(kept.trajectory.position, zigzag), cfg.trajectory.max_deviation);
 
   cfg.optimizer.weight_fidelity = 0.0;
+  cfg.trajectory.slow_zone_radius = 0.0;  // the whole path slowed, as when this rule came
   const GenerationResult loose =
       TrajectoryGenerator(cfg).generate(zigzag, yaws, at_rest(zigzag[0]), 0.0, FreeField());
   ASSERT_TRUE(loose.ok) << loose.reason;

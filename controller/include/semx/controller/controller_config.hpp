@@ -88,6 +88,11 @@ struct TrajectoryConfig {
   // sharp climb by 0.6 m, still moving down from the last path, hit the unmapped top of a sofa
   // (env2, 30 samples, seed 1).
   double max_deviation = 0.4;
+  // m: where the full-speed optimised curve fails (too close, or strays), it is optimised again at
+  // the fallback's cruise speed within this distance of the place only, up to slow_zone_tries
+  // places, before the whole path is (0: off, the whole path at once).
+  double slow_zone_radius = 1.5;
+  int slow_zone_tries = 3;
 };
 
 struct OptimizerConfig {

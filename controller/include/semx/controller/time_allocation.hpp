@@ -12,8 +12,10 @@ namespace semx::controller {
 class TimedPolyline {
  public:
   // `start_speed` along the first segment (clamped to [0, max_speed]); stops at the last point.
+  // `segment_speed`, when not empty (one per segment), lowers each segment's cruise speed further:
+  // the generator slows only the stretch of a path where the full-speed curve failed.
   TimedPolyline(std::vector<Eigen::Vector3d> points, double start_speed, double max_speed,
-                double max_acceleration, double knot_interval);
+                double max_acceleration, double knot_interval, const std::vector<double>& segment_speed = {});
 
   double duration() const {
     return segments_.empty() ? 0.0 : segments_.back().t_start + segments_.back().time;

@@ -44,8 +44,33 @@ struct GenerationResult {
   ClearanceReport clearance;  // of the returned trajectory, or of the last one tried
   double time_scale = 1.0;    // knot interval stretch applied for the limits
   bool slowed = false;        // optimised at the fallback's cruise speed (the full-speed curve failed)
+  int slow_zones = 0;         // ... only near this many points (0: along the whole path)
   int squared_headings = 0;   // path points whose heading was turned to face an obstacle
   int repaired_headings = 0;  // instants of the flown curve whose heading was held square (heading_repairs)
+};
+
+// Places along a path to fly at a lower speed: spheres around where a full-speed curve failed.
+struct SlowZones {
+  struct Zone {
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  // The polyline cut where it enters and leaves the zones, the headings spread over each cut
+  // segment by length, and each piece's cruise speed: v_slow when its middle is in a zone.
+  struct Split {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<double> yaws;
+    std::vector<double> speed;  // per piece
+  };
+  static constexpr double kMinPiece = 0.01;  // m: no piece shorter
+
+  // A zone around p; a p within half a zone's radius of its centre grows that zone 1.5 times
+  // instead (false).
+  bool add(const Eigen::Vector3d& p, double radius);
+  Split split(const std::vector<Eigen::Vector3d>& polyline, const std::vector<double>& yaws, double v_slow,
+              double v_fast) const;
+
+  std::vector<Zone> zones;
 };
 
 class TrajectoryGenerator {
@@ -73,8 +98,10 @@ class TrajectoryGenerator {
   // there for the first time now.
   ClearanceRule flight_rule(bool optimised = false) const;
 
-  // The farthest the curve gets from the polyline (sampled every kDeviationStep of its time).
-  static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline);
+  // The farthest the curve gets from the polyline (sampled every kDeviationStep of its time), and
+  // where on the curve (`where`, when given).
+  static double deviation(const PositionSpline& curve, const std::vector<Eigen::Vector3d>& polyline,
+                          Eigen::Vector3d* where = nullptr);
   static constexpr double kDeviationStep = 0.05;  // s
   // The point of the polyline nearest to p.
   static Eigen::Vector3d nearest_on_path(const Eigen::Vector3d& p,
@@ -85,10 +112,11 @@ class TrajectoryGenerator {
 
   // Step 1 alone: the optimiser's starting point (also what the perf tool times it from), and
   // the times the polyline's points are passed on it. It cruises at v_max and starts at the
-  // vehicle's velocity, no faster than max(v_max, v_start).
+  // vehicle's velocity, no faster than max(v_max, v_start); `segment_speed` (one per segment, or
+  // empty) slows some segments further (TimedPolyline).
   PositionSpline initial_spline(const std::vector<Eigen::Vector3d>& polyline, const StartState& start,
                                 double v_max, std::vector<double>* point_times = nullptr,
-                                double v_start = 0.0) const;
+                                double v_start = 0.0, const std::vector<double>& segment_speed = {}) const;
 
  private:
   // The vehicle's velocity (zero when not finite), no faster than v_max: where both curves start.
