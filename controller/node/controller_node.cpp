@@ -72,11 +72,12 @@ int ControllerNode::run() {
   const int code = node_.run();
   const ControllerCounters& c = controller_.counters();
   std::cout << "semx-controller: paths " << c.paths << ", trajectories " << c.trajectories << " (optimised "
-            << c.optimized << " (slowed " << c.slowed << "), fallback " << c.fallbacks << ": strayed "
-            << c.fallback_strays << ", too close " << c.fallback_too_close << "), squared headings "
-            << c.squared_headings << ", repaired headings " << c.repaired_headings << ", rejected "
-            << c.rejected << ", unsafe " << c.unsafe << ", brakes " << c.brakes << ", stale stops "
-            << c.stale_stops << ", off track " << c.off_track << std::endl;
+            << c.optimized << " (slowed " << c.slowed << ", of them near one place or a few only "
+            << c.slowed_near << "), fallback " << c.fallbacks << ": strayed " << c.fallback_strays
+            << ", too close " << c.fallback_too_close << "), squared headings " << c.squared_headings
+            << ", repaired headings " << c.repaired_headings << ", rejected " << c.rejected << ", unsafe "
+            << c.unsafe << ", brakes " << c.brakes << ", stale stops " << c.stale_stops << ", off track "
+            << c.off_track << std::endl;
   return code;
 }
 

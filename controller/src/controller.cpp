@@ -93,6 +93,7 @@ void Controller::process_path(int64_t now, StepOutput& out) {
   ++counters_.trajectories;
   ++(trajectory_->optimized ? counters_.optimized : counters_.fallbacks);
   if (last_generation_.slowed) ++counters_.slowed;
+  if (last_generation_.slowed && last_generation_.slow_zones > 0) ++counters_.slowed_near;
   counters_.squared_headings += last_generation_.squared_headings;
   counters_.repaired_headings += last_generation_.repaired_headings;
   if (!trajectory_->optimized) {

@@ -27,6 +27,7 @@ struct ControllerCounters {
   int64_t trajectories = 0;        // trajectories started
   int64_t optimized = 0;           // ... of which optimised
   int64_t slowed = 0;              //   at the fallback's cruise speed (the full-speed one failed)
+  int64_t slowed_near = 0;         //     ... only near where it failed (trajectory.slow_zone_radius)
   int64_t fallbacks = 0;           // ... of which the fallback, because the optimised one
   int64_t fallback_strays = 0;     //   strayed from the path (trajectory.max_deviation)
   int64_t fallback_too_close = 0;  //   failed the clearance check
