@@ -99,6 +99,26 @@ TEST(TimeAllocation, StartsStopsAndSlowsAtCorners) {
   }
 }
 
+TEST(TimeAllocation, ACappedSegmentIsFlownNoFasterThanItsCap) {
+  // Three straight 4 m segments, the middle one capped at 0.5 m/s: full speed before and after it,
+  // at most 0.5 on it, and slower overall than with no cap.
+  const std::vector<Eigen::Vector3d> pts{{0, 0, 1}, {4, 0, 1}, {8, 0, 1}, {12, 0, 1}};
+  const TimedPolyline capped(pts, 0.0, 1.0, 2.0, 0.25, {1.0, 0.5, 1.0});
+  const TimedPolyline free(pts, 0.0, 1.0, 2.0, 0.25);
+  double before = 0, on = 0, after = 0;
+  for (double t = 0; t <= capped.duration(); t += 0.01) {
+    const double x = capped.position(t).x();
+    double& top = x < 4 ? before : x <= 8 ? on : after;
+    top = std::max(top, capped.speed(t));
+  }
+  EXPECT_NEAR(before, 1.0, 1e-9);
+  EXPECT_LE(on, 0.5 + 1e-9);
+  EXPECT_NEAR(after, 1.0, 1e-9);
+  EXPECT_GT(capped.duration(), free.duration() + 3.5);  // 4 m at half speed, less the ramps
+  // A cap list of the wrong length is ignored.
+  EXPECT_DOUBLE_EQ(TimedPolyline(pts, 0.0, 1.0, 2.0, 0.25, {0.5}).duration(), free.duration());
+}
+
 TEST(TrajectoryGeneration, StraightPathInFreeSpaceIsFastSmoothAndEndsAtRest) {
   const ControllerConfig cfg;
   const TrajectoryGenerator gen(cfg);
