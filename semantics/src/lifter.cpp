@@ -1,12 +1,11 @@
-// PCL lives here only: voxel grid, statistical outlier removal and Euclidean clustering.
+// PCL lives here only: the voxel grid. The neighbour filters are cloud_filters' (nanoflann).
 #include "semx/semantics/lifter.hpp"
 
-#include <pcl/filters/statistical_outlier_removal.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/search/kdtree.h>
-#include <pcl/segmentation/extract_clusters.h>
+
+#include "semx/semantics/cloud_filters.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,24 +17,15 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 struct ObjectLifter::Impl {
   Cloud::Ptr raw{new Cloud};
   Cloud::Ptr down{new Cloud};
-  Cloud::Ptr filtered{new Cloud};
   pcl::VoxelGrid<pcl::PointXYZ> voxel;
-  pcl::StatisticalOutlierRemoval<pcl::PointXYZ> outliers;
-  // Unsorted neighbour lists: clustering and outlier removal do not need them sorted.
-  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree{new pcl::search::KdTree<pcl::PointXYZ>(false)};
-  pcl::EuclideanClusterExtraction<pcl::PointXYZ> clusters;
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> filtered;
   std::vector<float> depths;
 };
 
 ObjectLifter::ObjectLifter(const LiftConfig& config) : config_(config), impl_(std::make_unique<Impl>()) {
   const float leaf = static_cast<float>(config.voxel_size);
   impl_->voxel.setLeafSize(leaf, leaf, leaf);
-  impl_->outliers.setMeanK(std::max(1, config.outlier_neighbours));
-  impl_->outliers.setStddevMulThresh(config.outlier_stddev);
-  impl_->clusters.setClusterTolerance(config.cluster_tolerance);
-  impl_->clusters.setMinClusterSize(1);
-  impl_->clusters.setMaxClusterSize(std::numeric_limits<int>::max());
-  impl_->clusters.setSearchMethod(impl_->tree);
 }
 
 ObjectLifter::~ObjectLifter() = default;
@@ -131,23 +121,26 @@ std::optional<Detection3D> ObjectLifter::lift(const Frame& frame, const Detectio
 
   impl_->voxel.setInputCloud(impl_->raw);
   impl_->voxel.filter(*impl_->down);
-  Cloud::Ptr cloud = impl_->down;
-  if (config_.outlier_neighbours > 0 && static_cast<int>(cloud->size()) > config_.outlier_neighbours + 1) {
-    impl_->outliers.setInputCloud(cloud);
-    impl_->outliers.filter(*impl_->filtered);
-    cloud = impl_->filtered;
+  auto& points = impl_->points;
+  points.clear();
+  points.reserve(impl_->down->size());
+  for (const auto& q : *impl_->down) points.emplace_back(q.x, q.y, q.z);
+  if (config_.outlier_neighbours > 0 && static_cast<int>(points.size()) > config_.outlier_neighbours + 1) {
+    auto& filtered = impl_->filtered;
+    filtered.clear();
+    for (const uint32_t i :
+         remove_statistical_outliers(points, config_.outlier_neighbours, config_.outlier_stddev)) {
+      filtered.push_back(points[i]);
+    }
+    points.swap(filtered);
   }
-  if (static_cast<int>(cloud->size()) < config_.min_points) return fail(LiftOutcome::kTooFewPoints);
+  if (static_cast<int>(points.size()) < config_.min_points) return fail(LiftOutcome::kTooFewPoints);
 
-  std::vector<pcl::PointIndices> found;
-  impl_->tree->setInputCloud(cloud);
-  impl_->clusters.setInputCloud(cloud);
-  impl_->clusters.extract(found);
-  // extract() sorts clusters by size, largest first.
-  if (found.empty() || static_cast<int>(found.front().indices.size()) < config_.min_points) {
+  const auto found = euclidean_clusters(points, config_.cluster_tolerance);
+  if (found.empty() || static_cast<int>(found.front().size()) < config_.min_points) {
     return fail(LiftOutcome::kTooFewPoints);
   }
-  const auto& best = found.front().indices;
+  const auto& best = found.front();
 
   Detection3D d;
   d.cls = det.cls;
@@ -158,9 +151,8 @@ std::optional<Detection3D> ObjectLifter::lift(const Frame& frame, const Detectio
   d.image_box = det.box;
   d.points.reserve(best.size());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (int i : best) {
-    const auto& q = (*cloud)[static_cast<std::size_t>(i)];
-    const Eigen::Vector3f p(q.x, q.y, q.z);
+  for (const uint32_t i : best) {
+    const Eigen::Vector3f& p = points[i];
     d.points.push_back(p);
     d.box.extend(p.cast<double>());
     sum += p.cast<double>();

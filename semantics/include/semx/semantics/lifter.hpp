@@ -1,7 +1,7 @@
 // Stage 2: from a 2D detection to a 3D one. The detection's pixels with a valid depth are
-// back-projected with the frame's intrinsics and pose, then filtered with PCL: voxel-grid
-// downsampling, statistical outlier removal, Euclidean clustering (the largest cluster is the
-// object). PCL stays inside lifter.cpp.
+// back-projected with the frame's intrinsics and pose, then filtered: PCL's voxel-grid
+// downsampling, then statistical outlier removal and Euclidean clustering (cloud_filters.hpp;
+// the largest cluster is the object). PCL stays inside lifter.cpp.
 #pragma once
 
 #include <Eigen/Geometry>
