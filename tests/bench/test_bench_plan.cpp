@@ -222,6 +222,11 @@ TEST(BenchPlan, FlagErrorsNameTheFlag) {
   EXPECT_EQ(error_of({"--seeds", "2x"}), "--seeds '2x': expected a positive integer");
   EXPECT_EQ(error_of({"--samples", "-1"}), "--samples '-1': expected a positive integer");
   EXPECT_EQ(error_of({"--jobs", "0"}), "--jobs '0': expected a positive integer");
+  // Without --jobs, one set a core (at most 8); --jobs overrides it.
+  EXPECT_EQ(job_count(parse_bench_args({})), default_job_count());
+  EXPECT_GE(default_job_count(), 1);
+  EXPECT_LE(default_job_count(), 8);
+  EXPECT_EQ(job_count(parse_bench_args({"--jobs", "3"})), 3);
   EXPECT_EQ(error_of({"--planners", "dep,foo"}), "--planners: unknown planner 'foo'");
   EXPECT_EQ(error_of({"--planners", "nbv,aep,dep,semantic-dep,fuel", "--dry-run"}), "");  // every planner known
   EXPECT_EQ(error_of({"--sweep", "30,x"}), "--sweep: 'x' is not a positive integer (or paper)");

@@ -309,10 +309,14 @@ class Supervisor {
       struct rusage usage {};
       const pid_t pid = wait4(-1, &status, WNOHANG, &usage);
       if (pid <= 0) return;
-      // What a process held at its largest (Linux: KiB): the figure hostile-input campaigns and
-      // long runs report, read where it costs nothing.
-      char peak[48];
-      std::snprintf(peak, sizeof peak, " (peak RSS %.0f MB)", static_cast<double>(usage.ru_maxrss) / 1024.0);
+      // What a process held at its largest (Linux: KiB) and the CPU it used: the figures
+      // hostile-input campaigns, long runs and the bench's cost report, read where they cost
+      // nothing.
+      const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6; };
+      char peak[96];
+      std::snprintf(peak, sizeof peak, " (peak RSS %.0f MB, CPU %.1f s user + %.1f s system)",
+                    static_cast<double>(usage.ru_maxrss) / 1024.0, seconds(usage.ru_utime),
+                    seconds(usage.ru_stime));
       for (auto& c : children_) {
         if (c.pid != pid) continue;
         c.pid = -1;

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
+#include <thread>
 
 #include "semx/runtime/args.hpp"
 
@@ -168,10 +169,9 @@ void validate_bench_options(const BenchOptions& o) {
   if (!positive_integer(o.samples)) {
     throw ArgError("--samples '" + o.samples + "': expected a positive integer");
   }
-  if (!positive_integer(o.jobs)) throw ArgError("--jobs '" + o.jobs + "': expected a positive integer");
-  if (!o.base_port.empty() &&
-      (!positive_integer(o.base_port) || o.base_port.size() > 5 || std::stoi(o.base_port) < 1024 ||
-       std::stoi(o.base_port) + std::stoi(o.jobs) - 1 > 65535)) {
+  const int jobs = job_count(o);
+  if (!o.base_port.empty() && (!positive_integer(o.base_port) || o.base_port.size() > 5 ||
+                               std::stoi(o.base_port) < 1024 || std::stoi(o.base_port) + jobs - 1 > 65535)) {
     throw ArgError("--base-port '" + o.base_port +
                    "': expected a port from 1024 with --jobs ports free above it");
   }
@@ -199,7 +199,13 @@ int seed_count(const BenchOptions& o) {
   return n;
 }
 
+int default_job_count() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return static_cast<int>(std::clamp(cores, 1u, 8u));
+}
+
 int job_count(const BenchOptions& o) {
+  if (o.jobs.empty()) return default_job_count();
   int n = 0;
   if (!positive_integer(o.jobs, &n)) throw ArgError("--jobs '" + o.jobs + "': expected a positive integer");
   return n;
@@ -341,9 +347,9 @@ DIR/maps_WORLD.png (each planner's map.png, the seed of median coverage).
 --worlds generated: eight generated apartments of 50 to 600 m² and 1 to 14 rooms (semx-world gen,
 seeds 1-8, written to DIR/worlds/), time limits 300 s + 2 s per m² unless --time-limits names them.
 Time limits (simulated s): env1=300, env2=600, env3=900 by default. --logs keeps each run's
-LCM log (about 100 MB per run). --jobs N runs N process sets at once, each on its own LCM
-port (a lockstep set leaves part of the machine idle while it waits for acks; the metrics do not
-depend on it, only the wall times do): slot k talks on LCM_DEFAULT_URL (default
+LCM log (about 100 MB per run). --jobs N runs N process sets at once (default: one per core, at
+most 8), each on its own LCM port (a lockstep set leaves part of the machine idle while it waits
+for acks; the metrics do not depend on it, only the wall times do): slot k talks on LCM_DEFAULT_URL (default
 udpm://239.255.76.67:7667?ttl=0) with its port + k, or on --base-port P + k; recv_buf_size=4194304
 is added when the URL has none. --arg KEY=VALUE goes to every run's process set
 (tools/launch/demo.yaml), e.g. --arg semantics_config=FILE or --arg planner_config=FILE for an

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
 
     const int jobs = bench::job_count(o);
     std::cout << "semx: bench: " << runs.size() << " runs into " << out
-              << (jobs > 1 ? " (" + o.jobs + " at a time)" : "") << std::endl;
+              << (jobs > 1 ? " (" + std::to_string(jobs) + " at a time)" : "") << std::endl;
     bench::SchedulerOptions so;
     so.out_dir = out;
     so.launcher = runtime::executable_dir() + "/semx-launch";

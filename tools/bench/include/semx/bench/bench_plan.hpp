@@ -25,7 +25,7 @@ struct BenchOptions {
   std::string against;  // another bench's folder: the report pairs the runs with its (against.md)
   bool keep_logs = false;
   std::string clock = "lockstep";
-  std::string jobs = "1";
+  std::string jobs;       // "": one set a core (default_job_count)
   std::string base_port;  // "": the port of LCM_DEFAULT_URL (else 7667); slot k uses it + k
   bool dry_run = false;
   bool help = false;                     // --help was given: print bench_help() and nothing else
@@ -48,6 +48,10 @@ void validate_bench_options(const BenchOptions& o);
 // --seeds and --jobs as numbers (after validate_bench_options).
 int seed_count(const BenchOptions& o);
 int job_count(const BenchOptions& o);
+// Without --jobs: one process set per core, at most 8. The machine is saturated then (a set alone
+// waits for acks part of the time; two on two cores keep both busy), and each set holds up to
+// about 1 GB (the oracle's view cache), which 8 sets keep within a workstation's memory.
+int default_job_count();
 
 // The words of a list as bash split `${list//,/ }`: commas and blanks separate, empty words
 // vanish, and a word with a glob character is replaced by the paths it matches (kept as it is
