@@ -210,6 +210,49 @@ void edit_run(const std::string& root, const std::string& run, const std::string
 // Two benches of the same runs: each run of A paired with B's of the same world, planner and
 // seed; the paired differences with their intervals per planner, over all and per set of worlds;
 // collisions, DONE and the least coverage of each side; the runs without a partner listed.
+TEST(BenchReport, TheCostTableSumsEachProcesssCpuPerPlanner) {
+  const std::string root = test::temp_dir("bench_report_cost");
+  write_run(root, "env1", "dep", 1, 100, 10, 30);
+  write_run(root, "env1", "dep", 2, 50, 10, 30);
+  write_run(root, "env1", "fuel", 1, 80, 10, 30);
+  auto launch_log = [&](const std::string& run, const std::string& text) {
+    std::ofstream(fs::path(root) / run / "launch.log") << text;
+  };
+  // A restarted mapper's two lives are summed; lines that are no exit lines, or exit lines from
+  // before the CPU figures, are not read.
+  launch_log(
+      "env1-dep-s45-seed1",
+      "[semx-launch] mapper: started (pid 12)\n"
+      "[semx-launch] mapper: killed by signal Killed (peak RSS 100 MB, CPU 3.0 s user + 1.0 s system)\n"
+      "[semx-launch] mapper: exited with 0 (peak RSS 120 MB, CPU 10.0 s user + 2.0 s system)\n"
+      "[semx-launch] planner: exited with 0 (peak RSS 42 MB, CPU 5.5 s user + 0.5 s system)\n"
+      "[semx-launch] evaluator: exited with 0 (peak RSS 80 MB)\n");
+  launch_log("env1-dep-s45-seed2",
+             "[semx-launch] mapper: exited with 0 (peak RSS 120 MB, CPU 4.0 s user + 0.0 s system)\n"
+             "[semx-launch] planner: exited with 0 (peak RSS 42 MB, CPU 2.0 s user + 1.0 s system)\n");
+  launch_log("env1-fuel-s45-seed1",
+             "[semx-launch] planner: exited with 0 (peak RSS 42 MB, CPU 8.0 s user + 0.0 s system)\n"
+             "[semx-launch] ros_bridge: exited with 0 (peak RSS 30 MB, CPU 1.0 s user + 0.0 s system)\n");
+  const auto runs = load_bench_runs(root);
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_DOUBLE_EQ(runs[0].cpu_s.at("mapper"), 16.0);
+  EXPECT_EQ(runs[0].cpu_s.count("evaluator"), 0u);
+
+  const std::string md = bench_markdown(runs);
+  ASSERT_NE(md.find("### What the runs cost"), std::string::npos) << md;
+  // The set's processes first, in set order, then the others by name.
+  EXPECT_NE(md.find("| mapper | planner | ros_bridge | CPU s |"), std::string::npos) << md;
+  // dep: 2 runs, 150 simulated s, 20 wall s; mapper 16 + 4, planner 6 + 3, 29 s in all.
+  EXPECT_NE(md.find("| dep | 2 | 150 | 20 | 20.0 | 9.0 | - | 29.0 | 0.193 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| fuel | 1 | 80 | 10 | - | 8.0 | 1.0 | 9.0 | 0.113 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| all | 3 | 230 | 30 | 20.0 | 17.0 | 1.0 | 38.0 | 0.165 |"), std::string::npos) << md;
+
+  // Folders without a launch.log (older benches) give no cost table.
+  const std::string bare = test::temp_dir("bench_report_cost_bare");
+  write_run(bare, "env1", "dep", 1, 100, 10, 30);
+  EXPECT_EQ(bench_markdown(load_bench_runs(bare)).find("What the runs cost"), std::string::npos);
+}
+
 TEST(BenchReport, AgainstABaselineBenchPairsEachRunWithItsTwin) {
   const std::string a = test::temp_dir("bench_against_a"), b = test::temp_dir("bench_against_b");
   // dep: env1 seeds 1 and 2 (10 against 20 s, 30 against 20 s), a generated world (10 against 10).

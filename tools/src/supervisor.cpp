@@ -23,6 +23,7 @@
 #include "semx/runtime/monotonic_clock.hpp"
 #include "semx/runtime/parent_watch.hpp"
 #include "semx/runtime/restart_count.hpp"
+#include "semx/tools/process_usage.hpp"
 
 namespace semx::tools {
 
@@ -310,13 +311,11 @@ class Supervisor {
       const pid_t pid = wait4(-1, &status, WNOHANG, &usage);
       if (pid <= 0) return;
       // What a process held at its largest (Linux: KiB) and the CPU it used: the figures
-      // hostile-input campaigns, long runs and the bench's cost report, read where they cost
-      // nothing.
+      // hostile-input campaigns, long runs and the bench's cost table report, read where they
+      // cost nothing.
       const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6; };
-      char peak[96];
-      std::snprintf(peak, sizeof peak, " (peak RSS %.0f MB, CPU %.1f s user + %.1f s system)",
-                    static_cast<double>(usage.ru_maxrss) / 1024.0, seconds(usage.ru_utime),
-                    seconds(usage.ru_stime));
+      const std::string peak = usage_text(ProcessUsage{static_cast<double>(usage.ru_maxrss) / 1024.0,
+                                                       seconds(usage.ru_utime), seconds(usage.ru_stime)});
       for (auto& c : children_) {
         if (c.pid != pid) continue;
         c.pid = -1;

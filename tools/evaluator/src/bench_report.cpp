@@ -16,6 +16,7 @@
 
 #include "semx/evaluator/coverage_plot.hpp"
 #include "semx/evaluator/montage.hpp"
+#include "semx/tools/process_usage.hpp"
 
 namespace semx::evaluator {
 
@@ -266,6 +267,10 @@ BenchRun load_bench_run(const std::string& dir) {
       throw std::runtime_error(split_file + ": " + e.what());
     }
   }
+  std::ifstream launch_log(fs::path(dir) / "launch.log");
+  for (std::string line; std::getline(launch_log, line);) {
+    if (const auto exit = tools::parse_exit_line(line)) r.cpu_s[exit->first] += exit->second.cpu_s();
+  }
   const std::string csv = (fs::path(dir) / "coverage.csv").string();
   std::ifstream in(csv);
   if (in) {
@@ -328,6 +333,68 @@ static std::vector<BenchRun> tabled_only(const std::vector<BenchRun>& runs) {
 
 static std::string tables_markdown(const std::vector<BenchRun>& runs, const BenchReportOptions& o);
 
+// What the bench cost and who spent it: CPU seconds by process, summed over each planner's runs
+// (every run, at every density), with the wall and simulated seconds. Where a bench's time goes
+// when its sets keep every core busy; nothing when no run folder has the launcher's CPU figures.
+static std::string cost_markdown(const std::vector<BenchRun>& all) {
+  // The set's processes in the order they appear in a set; any other after them, by name.
+  const std::vector<std::string> order = {"simulator",  "mapper",    "semantics", "planner",
+                                          "controller", "evaluator", "logger"};
+  std::set<std::string> names;
+  for (const auto& r : all)
+    for (const auto& [name, s] : r.cpu_s) names.insert(name);
+  if (names.empty()) return "";
+  std::vector<std::string> columns;
+  for (const auto& n : order)
+    if (names.count(n)) columns.push_back(n);
+  for (const auto& n : names)
+    if (std::find(order.begin(), order.end(), n) == order.end()) columns.push_back(n);
+
+  struct Row {
+    int runs = 0;
+    double wall = 0, sim = 0, total = 0;
+    std::map<std::string, double> cpu;
+  };
+  std::map<std::string, Row> by_planner;
+  Row sum;
+  for (const auto& r : all) {
+    if (r.cpu_s.empty()) continue;
+    for (Row* row : {&by_planner[r.planner], &sum}) {
+      ++row->runs;
+      row->wall += r.wall_s;
+      row->sim += r.sim_s;
+      for (const auto& [name, s] : r.cpu_s) {
+        row->cpu[name] += s;
+        row->total += s;
+      }
+    }
+  }
+  std::vector<std::string> planners;
+  for (const auto& [p, row] : by_planner) planners.push_back(p);
+  std::stable_sort(planners.begin(), planners.end(), [](const std::string& a, const std::string& b) {
+    return planner_rank(a) < planner_rank(b);
+  });
+
+  std::ostringstream md;
+  md << "\n### What the runs cost (CPU s by process, summed over the runs; every run, disturbed or not)\n\n"
+     << "| Algorithm | runs | simulated s | wall s (exploration) |";
+  for (const auto& c : columns) md << " " << c << " |";
+  md << " CPU s | CPU s per simulated s |\n|---|---|---|---|";
+  for (std::size_t i = 0; i < columns.size(); ++i) md << "---|";
+  md << "---|---|\n";
+  auto row_line = [&](const std::string& label, const Row& row) {
+    md << "| " << label << " | " << row.runs << " | " << fmt(row.sim, 0) << " | " << fmt(row.wall, 0) << " |";
+    for (const auto& c : columns) {
+      const auto it = row.cpu.find(c);
+      md << " " << (it == row.cpu.end() ? std::string("-") : fmt(it->second, 1)) << " |";
+    }
+    md << " " << fmt(row.total, 1) << " | " << (row.sim > 0 ? fmt(row.total / row.sim, 3) : "N/A") << " |\n";
+  };
+  for (const auto& p : planners) row_line(p, by_planner[p]);
+  row_line("all", sum);
+  return md.str();
+}
+
 std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOptions& o) {
   std::string md = tables_markdown(tabled_only(all), o);
   std::string left_out;
@@ -354,6 +421,7 @@ std::string bench_markdown(const std::vector<BenchRun>& all, const BenchReportOp
         "termination | not valid | folder |\n|---|---|---|---|---|---|---|---|---|---|\n" +
         d.str();
   }
+  md += cost_markdown(all);
   return md;
 }
 

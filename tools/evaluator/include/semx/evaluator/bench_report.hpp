@@ -5,6 +5,7 @@
 // with every planner.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -36,6 +37,9 @@ struct BenchRun {
   // the tables, never in them; `restarts` says which and when ("mapper 12.3 s, ...").
   bool disturbed = false;
   std::string restarts;
+  // CPU seconds (user + system) of each process of the set, from the launcher's exit lines in
+  // DIR/launch.log (a restarted process's lives summed); empty when the folder has none.
+  std::map<std::string, double> cpu_s;
 };
 
 // Reads DIR/metrics.json and DIR/coverage.csv; throws std::runtime_error naming the file.
