@@ -1,5 +1,7 @@
 #include "semx/runtime/args.hpp"
 
+#include <malloc.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -147,6 +149,12 @@ std::string ArgParser::help() const {
 int run_main(const std::string& program, const std::function<int()>& body) {
   // Processes usually write into the launcher's pipes: line-buffer so lines arrive as they happen.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  // The processes allocate and free frame-sized buffers (camera images, map messages) at every
+  // frame. By default glibc hands buffers of 128 KiB and more back to the kernel (munmap, heap
+  // trim) and maps them again, and every page comes back as a page fault: system time for
+  // nothing (docs/runtime.md, "Memory the processes keep"). Keep them; peak RSS does not change.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
   try {
     return body();
   } catch (const ArgError& e) {
