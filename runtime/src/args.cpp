@@ -152,7 +152,7 @@ int run_main(const std::string& program, const std::function<int()>& body) {
   // The processes allocate and free frame-sized buffers (camera images, map messages) at every
   // frame. By default glibc hands buffers of 128 KiB and more back to the kernel (munmap, heap
   // trim) and maps them again, and every page comes back as a page fault: system time for
-  // nothing (docs/runtime.md, "Memory the processes keep"). Keep them; peak RSS does not change.
+  // nothing (docs/runtime.md, "Memory the processes keep"). Keep them; peak RSS grows by a few MB.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
   try {
