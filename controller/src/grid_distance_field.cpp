@@ -8,6 +8,19 @@
 
 namespace semx::controller {
 
+namespace {
+
+// max |v[i + step] - v[i]| over i < n (0 when n is 0), for finite values: Eigen's packet
+// reduction (SSE), whose result does not depend on the order (the maximum of finite values).
+float max_abs_step(const float* v, std::size_t n, std::size_t step) {
+  if (n == 0) return 0.0f;
+  using Run = Eigen::Map<const Eigen::ArrayXf>;
+  const Eigen::Index len = static_cast<Eigen::Index>(n);
+  return (Run(v + step, len) - Run(v, len)).abs().maxCoeff();
+}
+
+}  // namespace
+
 GridDistanceField::GridDistanceField(const Eigen::Vector3d& origin, double resolution, int nx, int ny, int nz,
                                      std::vector<float> values, double max_distance, OutsideWindow outside)
     : origin_(origin),
@@ -25,20 +38,17 @@ GridDistanceField::GridDistanceField(const Eigen::Vector3d& origin, double resol
     throw std::invalid_argument("value count is not nx*ny*nz");
   }
   // The interpolant's slope along an axis is a blend of neighbour differences along it, so the
-  // largest difference per axis bounds each gradient component.
+  // largest difference per axis bounds each gradient component. Every ESDF_LOCAL builds a field
+  // (3·10^5 cells at the defaults): the differences are taken as flat runs of the array, in SIMD, instead of
+  // a branch per cell per axis (that loop was 4 % of a process set's CPU, perf).
+  const std::size_t row = static_cast<std::size_t>(nx), plane = row * static_cast<std::size_t>(ny);
+  const float* v = values_.data();
   float dmax[3] = {0, 0, 0};
-  for (int z = 0; z < nz; ++z) {
-    for (int y = 0; y < ny; ++y) {
-      const std::size_t row = index(0, y, z);
-      for (int x = 0; x < nx; ++x) {
-        const float v = values_[row + x];
-        if (x + 1 < nx) dmax[0] = std::max(dmax[0], std::abs(values_[row + x + 1] - v));
-        if (y + 1 < ny) dmax[1] = std::max(dmax[1], std::abs(values_[row + x + nx] - v));
-        if (z + 1 < nz)
-          dmax[2] = std::max(dmax[2], std::abs(values_[row + x + static_cast<std::size_t>(nx) * ny] - v));
-      }
-    }
-  }
+  for (std::size_t r = 0; r < values_.size(); r += row)
+    dmax[0] = std::max(dmax[0], max_abs_step(v + r, row - 1, 1));
+  for (std::size_t p = 0; p < values_.size(); p += plane)
+    dmax[1] = std::max(dmax[1], max_abs_step(v + p, plane - row, row));
+  dmax[2] = max_abs_step(v, values_.size() - plane, plane);
   lipschitz_ = Eigen::Vector3d(dmax[0], dmax[1], dmax[2]).norm() / resolution_;
 }
 

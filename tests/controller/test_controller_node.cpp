@@ -139,10 +139,13 @@ TEST(ControllerNode, InconsistentOrNonFiniteMessagesAreMalformedAndNeverReachThe
   auto nan_value = esdf;
   nan_value.distance[17] = NAN;
   h.send(ch::ESDF_LOCAL, nan_value);
+  auto inf_value = esdf;
+  inf_value.distance.back() = -INFINITY;
+  h.send(ch::ESDF_LOCAL, inf_value);
   auto zero_res = esdf;
   zero_res.resolution = 0;
   h.send(ch::ESDF_LOCAL, zero_res);
-  EXPECT_EQ(h.malformed(ch::ESDF_LOCAL), 3);
+  EXPECT_EQ(h.malformed(ch::ESDF_LOCAL), 4);
 
   auto nan_odom = odometry({0, 0, 1}, h.utime);
   nan_odom.velocity[1] = NAN;

@@ -120,6 +120,37 @@ TEST(GridDistanceField, LipschitzBoundsTheSlopeEverywhere) {
   }
 }
 
+// The bound is built from the largest neighbour difference per axis, over flat runs of the
+// array; a difference that straddles a row or a plane (not neighbours) must not count, and thin
+// grids (one cell along an axis, runs shorter than the vector width) must be handled.
+TEST(GridDistanceField, LipschitzIsTheLargestNeighbourDifferencePerAxis) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const int sizes[][3] = {{1, 1, 1}, {1, 5, 3}, {7, 1, 2}, {9, 3, 1}, {17, 13, 5}, {100, 100, 30}};
+  for (const auto& s : sizes) {
+    const int nx = s[0], ny = s[1], nz = s[2];
+    std::vector<float> v(static_cast<std::size_t>(nx) * ny * nz);
+    for (float& x : v) x = u(rng);
+    // A row's last cell far above the rest: the step from it to the next row's first cell is not
+    // a neighbour difference and must not count.
+    v[nx - 1] = 50.0f;
+    const auto at = [&](int x, int y, int z) { return v[x + static_cast<std::size_t>(nx) * (y + ny * z)]; };
+    double dmax[3] = {0, 0, 0};
+    for (int z = 0; z < nz; ++z) {
+      for (int y = 0; y < ny; ++y) {
+        for (int x = 0; x < nx; ++x) {
+          if (x + 1 < nx) dmax[0] = std::max<double>(dmax[0], std::abs(at(x + 1, y, z) - at(x, y, z)));
+          if (y + 1 < ny) dmax[1] = std::max<double>(dmax[1], std::abs(at(x, y + 1, z) - at(x, y, z)));
+          if (z + 1 < nz) dmax[2] = std::max<double>(dmax[2], std::abs(at(x, y, z + 1) - at(x, y, z)));
+        }
+      }
+    }
+    const double want = Eigen::Vector3d(dmax[0], dmax[1], dmax[2]).norm() / 0.1;
+    const GridDistanceField g(Eigen::Vector3d::Zero(), 0.1, nx, ny, nz, v, 3.0, OutsideWindow::kFree);
+    EXPECT_DOUBLE_EQ(g.lipschitz(), want) << nx << " x " << ny << " x " << nz;
+  }
+}
+
 TEST(GridDistanceField, RejectsInconsistentSizes) {
   EXPECT_THROW(GridDistanceField(Eigen::Vector3d::Zero(), 0.1, 2, 2, 2, std::vector<float>(7), 1,
                                  OutsideWindow::kFree),
