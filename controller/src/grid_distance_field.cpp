@@ -10,8 +10,8 @@ namespace semx::controller {
 
 namespace {
 
-// max |v[i + step] - v[i]| over i < n (0 when n is 0), for finite values: Eigen's packet
-// reduction (SSE), whose result does not depend on the order (the maximum of finite values).
+// max |v[i + step] - v[i]| over i < n (0 when n is 0): Eigen's packet reduction (SSE), whose
+// result does not depend on the order, the values being finite (the constructor checks).
 float max_abs_step(const float* v, std::size_t n, std::size_t step) {
   if (n == 0) return 0.0f;
   using Run = Eigen::Map<const Eigen::ArrayXf>;
@@ -37,10 +37,11 @@ GridDistanceField::GridDistanceField(const Eigen::Vector3d& origin, double resol
       static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz)) {
     throw std::invalid_argument("value count is not nx*ny*nz");
   }
+  if (!all_finite(values_.data(), values_.size())) throw std::invalid_argument("a value is not finite");
   // The interpolant's slope along an axis is a blend of neighbour differences along it, so the
   // largest difference per axis bounds each gradient component. Every ESDF_LOCAL builds a field
-  // (3·10^5 cells at the defaults): the differences are taken as flat runs of the array, in SIMD, instead of
-  // a branch per cell per axis (that loop was 4 % of a process set's CPU, perf).
+  // (3·10^5 cells at the defaults): the differences are taken as flat runs of the array, in SIMD,
+  // instead of a branch per cell per axis (that loop was 4 % of a process set's CPU, perf).
   const std::size_t row = static_cast<std::size_t>(nx), plane = row * static_cast<std::size_t>(ny);
   const float* v = values_.data();
   float dmax[3] = {0, 0, 0};
@@ -50,6 +51,13 @@ GridDistanceField::GridDistanceField(const Eigen::Vector3d& origin, double resol
     dmax[1] = std::max(dmax[1], max_abs_step(v + p, plane - row, row));
   dmax[2] = max_abs_step(v, values_.size() - plane, plane);
   lipschitz_ = Eigen::Vector3d(dmax[0], dmax[1], dmax[2]).norm() / resolution_;
+}
+
+bool GridDistanceField::all_finite(const float* values, std::size_t n) {
+  // x - x is 0 for a finite x and NaN otherwise, so the sum is 0 exactly when every value is
+  // finite: a packet reduction, not a branch per value.
+  const Eigen::Map<const Eigen::ArrayXf> v(values, static_cast<Eigen::Index>(n));
+  return (v - v).sum() == 0.0f;
 }
 
 bool GridDistanceField::contains(const Eigen::Vector3d& p) const {

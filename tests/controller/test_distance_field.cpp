@@ -2,6 +2,7 @@
 // outside policy and the Lipschitz bound the clearance check pads with.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "fields.hpp"
@@ -161,4 +162,27 @@ TEST(GridDistanceField, RejectsInconsistentSizes) {
   EXPECT_THROW(GridDistanceField(Eigen::Vector3d::Zero(), 0.1, 0, 2, 2, std::vector<float>(0), 1,
                                  OutsideWindow::kFree),
                std::invalid_argument);
+}
+
+// The bound and every distance assume finite values; the check is a SIMD sum, which must still
+// see one bad value among many, wherever it is, and whatever kind it is.
+TEST(GridDistanceField, RejectsValuesThatAreNotFinite) {
+  const std::vector<float> good(100 * 100 * 3, 0.7f);
+  EXPECT_TRUE(GridDistanceField::all_finite(good.data(), good.size()));
+  EXPECT_TRUE(GridDistanceField::all_finite(good.data(), 0));
+  EXPECT_NO_THROW(
+      GridDistanceField(Eigen::Vector3d::Zero(), 0.1, 100, 100, 3, good, 3.0, OutsideWindow::kFree));
+  for (const float bad : {NAN, INFINITY, -INFINITY}) {
+    for (const std::size_t at : {std::size_t{0}, std::size_t{5}, good.size() / 2 + 1, good.size() - 1}) {
+      std::vector<float> v = good;
+      v[at] = bad;
+      EXPECT_FALSE(GridDistanceField::all_finite(v.data(), v.size())) << bad << " at " << at;
+      EXPECT_THROW(GridDistanceField(Eigen::Vector3d::Zero(), 0.1, 100, 100, 3, v, 3.0, OutsideWindow::kFree),
+                   std::invalid_argument);
+    }
+  }
+  // The largest finite values: their differences with themselves are 0, not an overflow.
+  std::vector<float> big(37, std::numeric_limits<float>::max());
+  big[3] = -std::numeric_limits<float>::max();
+  EXPECT_TRUE(GridDistanceField::all_finite(big.data(), big.size()));
 }

@@ -21,9 +21,14 @@ enum class OutsideWindow { kFree, kObstacle };
 class GridDistanceField : public DistanceField {
  public:
   GridDistanceField() = default;
-  // Throws std::invalid_argument on sizes that do not match or a non-positive resolution.
+  // Throws std::invalid_argument on sizes that do not match, a non-positive resolution or a value
+  // that is not finite.
   GridDistanceField(const Eigen::Vector3d& origin, double resolution, int nx, int ny, int nz,
                     std::vector<float> values, double max_distance, OutsideWindow outside);
+
+  // Whether every one of n values is finite, in SIMD (an ESDF_LOCAL holds 3·10^5): the check the
+  // constructor makes, for a node to count a message as malformed before it builds a field.
+  static bool all_finite(const float* values, std::size_t n);
 
   double distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const override;
   double lipschitz() const override { return lipschitz_; }
