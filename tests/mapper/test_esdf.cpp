@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <limits>
 #include <random>
 
 #include "mapper_test_util.hpp"
@@ -135,6 +136,49 @@ TEST(Esdf, InsideThickObstaclesSearchAndTransformMatchBruteForce) {
               << sc.unknown_as_occupied;
         }
     EXPECT_GT(deep, 50) << "random " << sc.random_boxes;  // the scene does test deep voxels
+  }
+}
+
+// The squared transform is exact: every cell's value equals the brute-force squared distance to
+// the nearest site, to the last bit (the envelope is kept in integers), on grids with sparse and
+// dense sites, long lines on each axis, and lines and grids without any site.
+TEST(Esdf, SquaredTransformEqualsBruteForceExactly) {
+  std::mt19937 rng(5);
+  const int shapes[][3] = {{40, 30, 12}, {120, 3, 2}, {3, 110, 4}, {5, 4, 100}, {17, 19, 23}};
+  EdtWorkspace work;
+  for (const auto& shape : shapes) {
+    const int nx = shape[0], ny = shape[1], nz = shape[2];
+    const size_t n = static_cast<size_t>(nx) * ny * nz;
+    for (const double density : {0.0, 0.002, 0.03, 0.4}) {
+      std::bernoulli_distribution site(density);
+      std::vector<uint8_t> grid(n);
+      std::vector<std::array<int, 3>> sites;
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+          for (int x = 0; x < nx; ++x) {
+            const bool s = site(rng);
+            grid[x + static_cast<size_t>(nx) * (y + static_cast<size_t>(ny) * z)] = s ? 1 : 0;
+            if (s) sites.push_back({x, y, z});
+          }
+      std::vector<float> out(n);
+      squared_edt(grid.data(), 1, nx, ny, nz, out.data(), work);
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+          for (int x = 0; x < nx; ++x) {
+            const float got = out[x + static_cast<size_t>(nx) * (y + static_cast<size_t>(ny) * z)];
+            if (sites.empty()) {
+              ASSERT_GE(got, kEdtInfinity);
+              continue;
+            }
+            int64_t best = std::numeric_limits<int64_t>::max();
+            for (const auto& p : sites) {
+              const int64_t dx = p[0] - x, dy = p[1] - y, dz = p[2] - z;
+              best = std::min(best, dx * dx + dy * dy + dz * dz);
+            }
+            ASSERT_EQ(got, static_cast<float>(best)) << nx << "x" << ny << "x" << nz << " density " << density
+                                                     << " at " << x << "," << y << "," << z;
+          }
+    }
   }
 }
 

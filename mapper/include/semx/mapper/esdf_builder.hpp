@@ -23,6 +23,15 @@
 
 namespace semx::mapper {
 
+// Scratch of squared_edt, kept between windows so that a recompute allocates nothing: a gathered
+// line, its transform, and the lower envelope (sample index, its value plus index squared, and
+// the left intersection as the fraction zn / zd).
+struct EdtWorkspace {
+  std::vector<float> line_in, line_out;
+  std::vector<int> v;
+  std::vector<int64_t> fv, zn, zd;
+};
+
 class EsdfBuilder {
  public:
   EsdfBuilder(const EsdfParams& params, double resolution);
@@ -55,8 +64,7 @@ class EsdfBuilder {
   map::EsdfGrid grid_;
   std::vector<uint8_t> obstacle_;
   std::vector<float> pos_, neg_;
-  std::vector<float> line_in_, line_out_, env_z_;
-  std::vector<int> env_v_;
+  EdtWorkspace edt_work_;
   std::vector<uint32_t> deep_;  // obstacle voxels with no non-obstacle face neighbour
   bool last_inside_transform_ = false;
   double search_budget_ = kDefaultSearchBudget;
@@ -66,8 +74,6 @@ class EsdfBuilder {
 // out[i] = squared distance from cell i to the nearest cell with site[i] == want, or a value
 // >= kEdtInfinity when there is none. Exposed for tests.
 inline constexpr float kEdtInfinity = 1.0e18f;
-void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, float* out,
-                 std::vector<float>& line_in, std::vector<float>& line_out, std::vector<float>& env_z,
-                 std::vector<int>& env_v);
+void squared_edt(const uint8_t* site, uint8_t want, int nx, int ny, int nz, float* out, EdtWorkspace& work);
 
 }  // namespace semx::mapper
