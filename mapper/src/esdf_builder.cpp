@@ -22,7 +22,7 @@ constexpr float kLinearInfinity = 1.0e9f;
 // envelope is kept in integers: each intersection is the fraction zn / zd, compared by
 // cross-multiplying. That is exact, where a float quotient is rounded, and it spares the division
 // and the int-to-float conversions: the mapper's CPU in an env2 process set fell by about a
-// seventh (docs/mapper.md, "ESDF"). Window sides are at most 10^4 voxels (MapperConfig), so
+// fifth (docs/mapper.md, "ESDF"). Window sides are at most 10^4 voxels (MapperConfig), so
 // the products stay far below 2^63.
 void edt_1d(const float* f, int n, float* d, EdtWorkspace& w) {
   int* v = w.v.data();
