@@ -75,6 +75,32 @@ bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regi
   return false;
 }
 
+std::vector<SemanticRegion> open_doors(const map::StateGrid& grid, const std::vector<SemanticRegion>& regions,
+                                       double radius, double min_share) {
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  std::vector<SemanticRegion> out;
+  const double step = grid.resolution();
+  const int n = static_cast<int>(std::floor(radius / step));
+  map::StateGrid::Reader r = grid.reader();
+  for (const SemanticRegion& d : regions) {
+    if (d.class_id != door || !d.centroid.allFinite()) continue;
+    if (min_share > 0) {
+      int64_t all = 0, unknown = 0;
+      for (int i = -n; i <= n; ++i) {
+        for (int j = -n; j <= n; ++j) {
+          if (i * i + j * j > n * n) continue;
+          ++all;
+          const Eigen::Vector3d p = d.centroid + Eigen::Vector3d(i * step, j * step, 0.0);
+          if (r.state(grid.keys().key(p)) == map::VoxelState::kUnknown) ++unknown;
+        }
+      }
+      if (static_cast<double>(unknown) < min_share * static_cast<double>(all)) continue;
+    }
+    out.push_back(d);
+  }
+  return out;
+}
+
 void add_room_change_cost(const std::vector<int>& room, double cost, TourProblem& problem) {
   const size_t n = static_cast<size_t>(problem.n);
   auto of = [&](size_t node) { return node == 0 ? -1 : room[node - 1]; };
@@ -124,7 +150,7 @@ double SemanticFuelStrategy::latency_weight(const PlanContext& ctx, const Fronti
   if (rules_.object_weight > 0)
     factor += rules_.object_weight * share_near_unfinished_objects(cluster.voxels, ctx.grid->keys(),
                                                                    *ctx.regions, rules_.object_margin, 64);
-  if (rules_.door_weight > 0 && near_door(cluster.mean, *ctx.regions, rules_.doorway_radius))
+  if (rules_.door_weight > 0 && near_door(cluster.mean, doors_, rules_.doorway_radius))
     factor += rules_.door_weight;
   return coverage * factor;
 }
@@ -203,6 +229,9 @@ PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
       return o;
     }
   }
+  doors_.clear();
+  if (rules_.door_weight > 0 && ctx.regions)
+    doors_ = open_doors(*ctx.grid, *ctx.regions, rules_.door_probe_radius, rules_.door_open_share);
   if (rules_.greedy_ratio > 0) return plan_greedy(ctx);
   return FuelStrategy::plan(ctx);
 }

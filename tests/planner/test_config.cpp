@@ -136,6 +136,8 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(semantic_fuel.greedy_ratio);
   SAME(semantic_fuel.object_weight);
   SAME(semantic_fuel.door_weight);
+  SAME(semantic_fuel.door_open_share);
+  SAME(semantic_fuel.door_probe_radius);
 #undef SAME
 }
 

@@ -172,6 +172,54 @@ TEST(SemanticFuel, WithoutADoorAtTheSmallClusterItFliesFuelsTour) {
   }
 }
 
+TEST(SemanticFuel, AnOpenDoorHasThatShareOfItsDiscUnknown) {
+  map::StateGrid g(0.1);
+  const SemanticRegion door = door_at({2.0, 2.0, 1.0});
+  SemanticRegion chair = door;
+  chair.class_id = static_cast<int>(runtime::SemanticClass::kChair);
+  const std::vector<SemanticRegion> regions{door, chair};
+  // Nothing mapped: the door opens on unknown space; a chair is never a door.
+  ASSERT_EQ(open_doors(g, regions, 1.0, 0.9).size(), 1u);
+  EXPECT_EQ(open_doors(g, regions, 1.0, 0.9)[0].class_id, door.class_id);
+  // One side mapped (x < 2 m): about half the disc unknown.
+  fill_m(g, {0.0, 0.0, 0.5}, {2.0, 4.0, 1.5}, map::VoxelState::kFree);
+  EXPECT_EQ(open_doors(g, regions, 1.0, 0.4).size(), 1u);
+  EXPECT_TRUE(open_doors(g, regions, 1.0, 0.6).empty());
+  // Only the disc at the door's height counts: space above and below it stays unknown.
+  fill_m(g, {2.0, 0.0, 0.9}, {4.0, 4.0, 1.1}, map::VoxelState::kFree);
+  EXPECT_TRUE(open_doors(g, regions, 1.0, 0.01).empty());
+  // Both sides mapped, but the disc reaches unknown space beyond 2 m: a larger radius sees it.
+  EXPECT_EQ(open_doors(g, regions, 3.0, 0.2).size(), 1u);
+  EXPECT_EQ(open_doors(g, regions, 1.0, 0.0).size(), 1u) << "min_share 0: every door";
+}
+
+TEST(SemanticFuel, TheDoorWeightCountsOnlyDoorsWithSpaceStillToSeeAroundThem) {
+  // The pocket stands for a doorway's small frontier (toured with the large clusters as a
+  // doorway cluster): the latency tour leaves it for later by its few voxels, and the door's
+  // weight puts it first while the door counts.
+  const SemanticRegion door = door_at({1.0, 3.6, 1.0});
+  auto first = [&](double door_weight, double open_share) {
+    PocketScene s;
+    s.config.fuel.latency_tour = true;
+    s.config.semantic_fuel.object_pockets = false;
+    s.config.semantic_fuel.door_clusters = true;
+    s.config.semantic_fuel.door_weight = door_weight;
+    s.config.semantic_fuel.door_open_share = open_share;
+    s.regions = {door};
+    SemanticFuelStrategy sem(s.config);
+    return s.first_site(sem);
+  };
+  PocketScene ref;
+  // The scene's share of unknown voxels around the door: the pocket and the space behind the walls.
+  const std::vector<SemanticRegion> doors{door};
+  ASSERT_EQ(open_doors(ref.grid, doors, 2.0, 0.1).size(), 1u);
+  ASSERT_TRUE(open_doors(ref.grid, doors, 2.0, 0.5).empty());
+  EXPECT_FALSE(ref.at_pocket(first(0.0, 0.0))) << "the scene is meant to leave the pocket for later";
+  EXPECT_TRUE(ref.at_pocket(first(1000.0, 0.0))) << "every door counts";
+  EXPECT_TRUE(ref.at_pocket(first(1000.0, 0.1))) << "this door has that much unknown around it";
+  EXPECT_FALSE(ref.at_pocket(first(1000.0, 0.5))) << "this door has not";
+}
+
 TEST(SemanticFuel, NearADoorIsWithinTheRadiusHorizontally) {
   const std::vector<SemanticRegion> doors{door_at({2.0, 0.0, 1.0})};
   EXPECT_TRUE(near_door({3.4, 0.0, 2.4}, doors, 1.5));  // height does not count

@@ -240,6 +240,12 @@ struct SemanticFuelConfig {
   // ... and a door region means a room behind it: a site whose cluster's mean lies within
   // doorway_radius of a door weighs 1 + door_weight times its coverage. 0: off.
   double door_weight = 0.0;
+  // ... counting only doors with a room behind them still to see: at least door_open_share of the
+  // voxels within door_probe_radius of the door's centroid (a disc at its height) unknown. A door
+  // leaf is seen from both rooms, and once both are mapped its doorway leads nowhere new (every
+  // door counted, door_weight lost: docs/planner.md). 0: every door.
+  double door_open_share = 0.0;
+  double door_probe_radius = 2.0;  // m
 };
 
 // The main loop: when to replan, when to give up.

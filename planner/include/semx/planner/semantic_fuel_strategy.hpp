@@ -60,6 +60,8 @@ class SemanticFuelStrategy : public FuelStrategy {
   // dep_first_s: DEP's roadmap decides until then (it is fed the map all along); greedy_ratio: it
   // decides while its goal is flown.
   std::unique_ptr<DepStrategy> dep_;
+  // door_weight: the doors that count in this plan (open_doors()).
+  std::vector<SemanticRegion> doors_;
   int64_t first_utime_ = -1;
   bool dep_now_ = false;
   int turns_done_ = 0;
@@ -84,6 +86,12 @@ double share_near_unfinished_objects(const std::vector<map::VoxelKey>& voxels, c
 
 // Whether `p` lies within `radius` (horizontally) of a door region's centroid.
 bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius);
+
+// The door regions of `regions` with a room behind them still to see: at least `min_share` of the
+// voxels of `grid` within `radius` (horizontally) of the door's centroid, at its height, are
+// unknown. min_share 0: every door.
+std::vector<SemanticRegion> open_doors(const map::StateGrid& grid, const std::vector<SemanticRegion>& regions,
+                                       double radius, double min_share);
 
 // Adds `cost` to the first leg (from the vehicle, node 0) into every site that is not a doorway's
 // while any site is (`doorway[i]` is node i + 1's): the tour starts with a doorway.
