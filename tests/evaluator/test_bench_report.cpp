@@ -124,7 +124,7 @@ TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
   const fs::path split = fs::path(root) / "generated-s1-a50-r1-dep-s45-seed1" / "time_split.json";
   std::ofstream(split) << "{\"revisit_by_place_m\": 7.5, \"uses\": {\"new\": {\"time_s\": 40}, \"revisit\": "
                           "{\"time_s\": 30}, \"turn\": {\"time_s\": 10}, \"hover\": {\"time_s\": 0}, "
-                          "\"end_game\": {\"time_s\": 20}}}\n";
+                          "\"end_game\": {\"time_s\": 20}}, \"slice_s\": 6, \"slices\": \"nrntnnhh\"}\n";
   const std::string md = bench_markdown(load_bench_runs(root));
   // Differences -10 and -10 s; relative -50 % and -25 %: mean -37.5, sd 17.68, t(1) 12.706. As a
   // share of dep's mean time (20 and 40 s: 30 s), -10 s is -33.3 % in both pairs.
@@ -137,6 +137,20 @@ TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| generated (2 worlds) | dep | 1 | 40.0 |"), std::string::npos) << md;
+  // Up to Time_r (20 s) from the 6 s slices: new 0-6 and 12-18, revisit 6-12, then 2 s of the turn.
+  EXPECT_NE(md.find("| generated-s1-a50-r1 | dep | 1 | 12.0 | 6.0 | 2.0 | 0.0 | 20.0 |\n"), std::string::npos)
+      << md;
+  // A slice letter the report does not know names the file.
+  std::ofstream(split) << "{\"revisit_by_place_m\": 0, \"uses\": {\"new\": {\"time_s\": 1}, \"revisit\": "
+                          "{\"time_s\": 0}, \"turn\": {\"time_s\": 0}, \"hover\": {\"time_s\": 0}, "
+                          "\"end_game\": {\"time_s\": 0}}, \"slice_s\": 6, \"slices\": \"nx\"}\n";
+  try {
+    load_bench_runs(root);
+    ADD_FAILURE() << "an unknown slice use was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("time_split.json: unknown slice use 'x'"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(BenchReport, EveryPlannerIsDividedByTheOracleAndTheEndGameIsTabled) {

@@ -32,6 +32,9 @@ struct BenchRun {
   // time_split.json (empty when the folder has none): seconds of new, revisit, turn, hover and
   // end game, and the metres flown over ground flown before.
   std::vector<double> split_s;
+  // ... and the same five up to Time_r (from the slices; empty when 85 % was never reached): where
+  // the time to 85 % went, which the whole run's split hides under its end game.
+  std::vector<double> split_to_r_s;
   double revisit_by_place_m = 0;
   // A process of the set was restarted during the run (metrics.json "disturbed"): listed under
   // the tables, never in them; `restarts` says which and when ("mapper 12.3 s, ...").
