@@ -147,7 +147,7 @@ double SemanticFuelStrategy::latency_weight(const PlanContext& ctx, const Fronti
   double factor = 1.0;
   // 64 voxels spread over the cluster give its share to a few per cent, at a cost per plan that
   // does not grow with the cluster.
-  if (rules_.object_weight > 0)
+  if (rules_.object_weight != 0)
     factor += rules_.object_weight * share_near_unfinished_objects(cluster.voxels, ctx.grid->keys(),
                                                                    *ctx.regions, rules_.object_margin, 64);
   if (rules_.door_weight > 0 && near_door(cluster.mean, doors_, rules_.doorway_radius))

@@ -220,6 +220,27 @@ TEST(SemanticFuel, TheDoorWeightCountsOnlyDoorsWithSpaceStillToSeeAroundThem) {
   EXPECT_FALSE(ref.at_pocket(first(1000.0, 0.5))) << "this door has not";
 }
 
+TEST(SemanticFuel, ANegativeObjectWeightLeavesTheFrontierAtUnfinishedObjectsForLater) {
+  // The pocket stands for a doorway's small frontier (toured with the large clusters as a doorway
+  // cluster), and an object's box covers the second room's frontier: the latency tour goes there
+  // first by its many voxels, unless what lies at an unfinished object weighs less.
+  auto first = [](double object_weight, bool active) {
+    PocketScene s;
+    s.config.fuel.latency_tour = true;
+    s.config.semantic_fuel.object_pockets = false;
+    s.config.semantic_fuel.door_clusters = true;
+    s.config.semantic_fuel.object_weight = object_weight;
+    s.regions = {door_at({1.0, 3.6, 1.0}),
+                 region(runtime::SemanticClass::kTable, {5.7, 2.0, 1.35}, {1.0, 4.0, 2.7}, active)};
+    SemanticFuelStrategy sem(s.config);
+    return s.first_site(sem);
+  };
+  PocketScene ref;
+  EXPECT_FALSE(ref.at_pocket(first(0.0, true))) << "the scene is meant to leave the pocket for later";
+  EXPECT_TRUE(ref.at_pocket(first(-1.0, true))) << "the second room's frontier lies at an unfinished object";
+  EXPECT_FALSE(ref.at_pocket(first(-1.0, false))) << "a fully observed object changes no weight";
+}
+
 TEST(SemanticFuel, NearADoorIsWithinTheRadiusHorizontally) {
   const std::vector<SemanticRegion> doors{door_at({2.0, 0.0, 1.0})};
   EXPECT_TRUE(near_door({3.4, 0.0, 2.4}, doors, 1.5));  // height does not count

@@ -235,7 +235,9 @@ struct SemanticFuelConfig {
   // With fuel.latency_tour: what an object not yet fully observed is worth in the tour's order. A
   // site's weight (its coverage) is multiplied by 1 + object_weight × the share of its cluster's
   // voxels within object_margin of such an object's box, so the tour sees the unseen sides of
-  // objects sooner without touring anything it would not. 0: the latency tour's weights.
+  // objects sooner without touring anything it would not. Negative (down to -1): the other way,
+  // the frontier at an unfinished object is a detail of it (the space under a table, behind a
+  // cabinet), left for after the rooms. 0: the latency tour's weights.
   double object_weight = 0.0;
   // ... and a door region means a room behind it: a site whose cluster's mean lies within
   // doorway_radius of a door weighs 1 + door_weight times its coverage. 0: off.
