@@ -499,6 +499,14 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
     };
     Tour tour = solve_open_tour(problem, f.exact_tour_max);
     if (f.latency_tour) tour = by_latency(std::move(tour), false);
+    if (f.latency_tour && f.rate_first && tour.order.size() > 1) {
+      const int best = highest_rate_node(problem, weight);
+      Tour t;
+      t.order = {best};
+      for (int v : tour.order)
+        if (v != best) t.order.push_back(v);
+      tour = by_latency(std::move(t), true);
+    }
     if (keep_cost) {
       *keep_cost = kInf;
       for (int i = 0; i < n - 1; ++i) {

@@ -188,6 +188,17 @@ double latency_cost(const TourProblem& p, const std::vector<int>& order, const s
   return sum;
 }
 
+int highest_rate_node(const TourProblem& p, const std::vector<double>& weight) {
+  int best = -1;
+  double best_rate = -1.0;
+  for (int v = 1; v < p.n; ++v) {
+    // A leg under a millisecond is a site the vehicle is at: it outranks every site farther away.
+    const double rate = weight[static_cast<std::size_t>(v)] / std::max(p.at(0, v), 1e-3);
+    if (rate > best_rate) best_rate = rate, best = v;
+  }
+  return best;
+}
+
 double tour_cost(const std::vector<std::vector<double>>& cost, const std::vector<int>& order) {
   double c = 0.0;
   for (std::size_t i = 1; i < order.size(); ++i)

@@ -119,6 +119,7 @@ TEST(PlannerConfig, TheShippedYamlIsExactlyTheDefaults) {
   SAME(fuel.latency_evaluations);
   SAME(fuel.latency_gain);
   SAME(fuel.latency_gain_power);
+  SAME(fuel.rate_first);
   SAME(fuel.search_step);
   SAME(fuel.low_clearance_penalty);
   SAME(fuel.cost_budget);

@@ -264,6 +264,27 @@ TEST(TourSolver, TheLatencyOrderSeesTheLargeSiteFirst) {
   EXPECT_DOUBLE_EQ(objective(order), 300.0 + 4.0 + 9.0);
 }
 
+TEST(TourSolver, TheHighestRateNodeIsTheMostSeenPerSecondOfTheFirstLeg) {
+  // A small site 1 s ahead on the way to a large one 2 s ahead: the latency order takes the small
+  // one on the way (1 + 3 x 2 = 7 against 3 x 2 + 1 x 3 = 9), the rate (1 against 1.5) the large one.
+  TourProblem p;
+  p.n = 3;
+  p.cost = {0, 1, 2, 1, 0, 1, 2, 1, 0};
+  const std::vector<double> weight = {0.0, 1.0, 3.0};
+  EXPECT_LT(latency_cost(p, {1, 2}, weight), latency_cost(p, {2, 1}, weight));
+  EXPECT_EQ(highest_rate_node(p, weight), 2);
+  // A site the vehicle is at outranks any other; equal rates keep the first.
+  p.cost[1] = 0.0;
+  EXPECT_EQ(highest_rate_node(p, weight), 1);
+  EXPECT_EQ(highest_rate_node(p, {0.0, 2.0, 4.0}), 1);
+  p.cost[1] = 1.0;
+  EXPECT_EQ(highest_rate_node(p, {0.0, 2.0, 4.0}), 1);
+  TourProblem none;
+  none.n = 1;
+  none.cost = {0.0};
+  EXPECT_EQ(highest_rate_node(none, {0.0}), -1);
+}
+
 TEST(TourSolver, TheLatencyOrderFromTheShortestTourIsNearTheBest) {
   // Random asymmetric costs and weights: the local moves from the shortest tour never do worse
   // than it, and come within a few per cent of the brute-force best order on the mean.

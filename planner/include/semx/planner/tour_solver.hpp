@@ -33,6 +33,9 @@ double open_path_cost(const TourProblem& p, const std::vector<int>& order);
 // times the cost of the path up to that node (what a tour that should see the most soonest
 // minimises, where open_path_cost is the time to see everything).
 double latency_cost(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight);
+// The node (1..n-1) of the highest rate weight[node] / cost from node 0 (a greedy planner's next
+// goal: the most seen per second of flight), the first of equals; -1 when there is none.
+int highest_rate_node(const TourProblem& p, const std::vector<double>& weight);
 // The best open tour; with `first` >= 1 the tour must visit that node first.
 Tour solve_open_tour(const TourProblem& p, int exact_max, int first = -1);
 // The two methods on their own (tests compare them with brute force).
