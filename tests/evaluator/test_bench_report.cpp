@@ -140,6 +140,11 @@ TEST(BenchReport, GeneratedWorldsArePooledAndTheTimeSplitIsTabled) {
   // Up to Time_r (20 s) from the 6 s slices: new 0-6 and 12-18, revisit 6-12, then 2 s of the turn.
   EXPECT_NE(md.find("| generated-s1-a50-r1 | dep | 1 | 12.0 | 6.0 | 2.0 | 0.0 | 20.0 |\n"), std::string::npos)
       << md;
+  // Without the slices (a folder from before them) there is no such table.
+  std::ofstream(split) << "{\"revisit_by_place_m\": 0, \"uses\": {\"new\": {\"time_s\": 1}, \"revisit\": "
+                          "{\"time_s\": 0}, \"turn\": {\"time_s\": 0}, \"hover\": {\"time_s\": 0}, "
+                          "\"end_game\": {\"time_s\": 0}}}\n";
+  EXPECT_EQ(bench_markdown(load_bench_runs(root)).find("Up to Time_r"), std::string::npos);
   // A slice letter the report does not know names the file.
   std::ofstream(split) << "{\"revisit_by_place_m\": 0, \"uses\": {\"new\": {\"time_s\": 1}, \"revisit\": "
                           "{\"time_s\": 0}, \"turn\": {\"time_s\": 0}, \"hover\": {\"time_s\": 0}, "

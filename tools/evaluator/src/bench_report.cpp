@@ -624,11 +624,15 @@ static std::string tables_markdown(const std::vector<BenchRun>& runs, const Benc
                   p, g, to_r);
     };
     split_table(false);
-    md << "\nUp to Time_r (85 % of the volume; the runs that reached it): where the time to 85 % went. "
-          "Revisits here are transits that delayed 85 %, not the end game's.\n\n"
-       << "| Env. | Algorithm | runs | new | revisit | turn | hover | Time_r |\n"
-       << "|---|---|---|---|---|---|---|---|\n";
-    split_table(true);
+    bool any_to_r = false;
+    for (const auto& r : runs) any_to_r |= !r.split_to_r_s.empty();
+    if (any_to_r) {
+      md << "\nUp to Time_r (85 % of the volume; the runs that reached it): where the time to 85 % went. "
+            "Revisits here are transits that delayed 85 %, not the end game's.\n\n"
+         << "| Env. | Algorithm | runs | new | revisit | turn | hover | Time_r |\n"
+         << "|---|---|---|---|---|---|---|---|\n";
+      split_table(true);
+    }
   }
   double wall = 0, sim = 0;
   for (const auto& r : runs) {
