@@ -52,9 +52,7 @@ std::string TimeSplitResult::to_json() const {
       << ", \"new_m3\": " << num(new_m3[static_cast<size_t>(i)]) << "}";
   }
   s << "\n  },\n  \"slices\": \"";
-  // One letter per slice (n r t h e), so the run's sequence reads at a glance and stays small.
-  static const char kLetter[kTimeUses] = {'n', 'r', 't', 'h', 'e'};
-  for (const TimeSlice& sl : slices) s << kLetter[static_cast<size_t>(sl.use)];
+  for (const TimeSlice& sl : slices) s << kTimeUseLetters[static_cast<size_t>(sl.use)];
   s << "\"\n}\n";
   return s.str();
 }

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "semx/core/time_split.hpp"
 #include "semx/evaluator/coverage_plot.hpp"
 #include "semx/evaluator/montage.hpp"
 #include "semx/tools/process_usage.hpp"
@@ -260,18 +261,18 @@ BenchRun load_bench_run(const std::string& dir) {
   if (fs::exists(split_file)) {
     try {
       const YAML::Node t = YAML::LoadFile(split_file);
-      for (const char* use : {"new", "revisit", "turn", "hover", "end_game"})
-        r.split_s.push_back(t["uses"][use]["time_s"].as<double>());
+      for (int u = 0; u < core::kTimeUses; ++u)
+        r.split_s.push_back(t["uses"][core::to_string(static_cast<core::TimeUse>(u))]["time_s"].as<double>());
       r.revisit_by_place_m = t["revisit_by_place_m"].as<double>();
       if (r.time_r_s && t["slices"] && t["slice_s"]) {
         const double dt = t["slice_s"].as<double>();
         const std::string letters = t["slices"].as<std::string>();
-        static const std::string kUses = "nrthe";  // TimeSplitResult::to_json()'s letters, in TimeUse order
-        r.split_to_r_s.assign(kUses.size(), 0.0);
+        const std::string use_letters = core::kTimeUseLetters;
+        r.split_to_r_s.assign(use_letters.size(), 0.0);
         for (size_t k = 0; k < letters.size(); ++k) {
           const double in = std::min(dt, *r.time_r_s - static_cast<double>(k) * dt);
           if (!(in > 0)) break;
-          const size_t u = kUses.find(letters[k]);
+          const size_t u = use_letters.find(letters[k]);
           if (u == std::string::npos)
             throw std::runtime_error(split_file + ": unknown slice use '" + letters[k] + "'");
           r.split_to_r_s[u] += in;

@@ -31,6 +31,9 @@ namespace semx::core {
 enum class TimeUse : uint8_t { kNew = 0, kRevisit = 1, kTurn = 2, kHover = 3, kEndGame = 4 };
 inline constexpr int kTimeUses = 5;
 const char* to_string(TimeUse u);  // "new", "revisit", "turn", "hover", "end_game"
+// time_split.json's "slices": one letter per slice, the use's in TimeUse order, so the run's
+// sequence reads at a glance and stays small (the bench report reads it back).
+inline constexpr char kTimeUseLetters[kTimeUses + 1] = "nrthe";
 
 struct TimeSplitOptions {
   double slice_s = 0.5;      // s
