@@ -393,7 +393,7 @@ void DepStrategy::evaluate_gain(PlanContext& ctx, int64_t id) {
 DepStrategy::View DepStrategy::view_of(PlanContext& ctx, const ScoreFn& score, int64_t id, bool sweep) const {
   const RoadmapNode& n = graph_.node(id);
   const double reward = reward_at(ctx, n.position, n.gain.yaw);
-  const double d = search_.distance[static_cast<size_t>(id)];
+  const double d = scored_distance(id);
   View v{n.gain.yaw, n.gain.gain, reward,
          score(n.gain.gain, reward, d, core::yaw_distance(ctx.pose.yaw, n.gain.yaw))};
   if (!sweep) return v;
@@ -488,6 +488,8 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
     ctx.counters->search_ms += w.ms();
   }
   update_region_factors(ctx);
+  extra_distance_.clear();
+  searched(ctx);
   // A node must score above this to change what the main loop flies (ctx.flown).
   double bar = -std::numeric_limits<double>::infinity();
   if (flown && !tier && !(config_.cost.local_first > 0)) {
@@ -565,7 +567,7 @@ Goal DepStrategy::select_goal(PlanContext& ctx, const ScoreFn& score, std::strin
         double turn = core::yaw_distance(ctx.pose.yaw, f->yaws.front());
         for (size_t i = 1; i < f->yaws.size(); ++i) turn += core::yaw_distance(f->yaws[i - 1], f->yaws[i]);
         const size_t i = static_cast<size_t>(id);
-        const double flown = score(view_gain_[i], reward_[i], search_.distance[i], turn);
+        const double flown = score(view_gain_[i], reward_[i], scored_distance(id), turn);
         if (flown < score_[i] - 1e-9) {
           score_[i] = flown;
           cost_[i] = travel_time(search_.distance[i], turn, config_.cost);

@@ -3,11 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 
 #include "semx/planner/tour_solver.hpp"
 #include "semx/runtime/semantic_classes.hpp"
 
 namespace semx::planner {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
 
 SemanticRoomStrategy::SemanticRoomStrategy(const PlannerConfig& config)
     : DepStrategy(config, config.room.eq6_reward), rules_(config.room) {}
@@ -53,6 +58,7 @@ void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
   // The vehicle's room is room 0 (none when it stands in a doorway).
   const bool in_room = root() >= 0 && room_[static_cast<size_t>(root())] == kUnlabelled;
   if (in_room) flood(root());
+  vehicle_room_ = in_room ? 0 : -1;
   for (const RoadmapNode& n : g.slots()) {
     if (room_[static_cast<size_t>(n.id)] == kUnlabelled) flood(n.id);
   }
@@ -110,6 +116,35 @@ void SemanticRoomStrategy::choose_target(PlanContext& ctx, int rooms) {
   }
   const Tour t = solve_open_tour(p, 10);
   target_ = t.order.empty() ? -1 : candidates[static_cast<size_t>(t.order.front() - 1)];
+}
+
+void SemanticRoomStrategy::searched(PlanContext& ctx) {
+  if (!(rules_.return_weight > 0)) return;
+  label_rooms(ctx);
+  const Roadmap& g = graph();
+  const Roadmap::Search& reach = last_search();
+  // Each room's entry: the nearest (from the vehicle) doorway node next to one of its nodes.
+  std::vector<double> entry;
+  for (const RoadmapNode& n : g.slots()) {
+    const int r = room_[static_cast<size_t>(n.id)];
+    if (r < 0 || r == vehicle_room_) continue;
+    if (entry.size() <= static_cast<size_t>(r)) entry.resize(static_cast<size_t>(r) + 1, kInf);
+    for (const RoadmapEdge& e : n.edges) {
+      if (room_[static_cast<size_t>(e.to)] != -1 || !reach.reached(e.to)) continue;
+      entry[static_cast<size_t>(r)] = std::min(entry[static_cast<size_t>(r)], reach.distance[static_cast<size_t>(e.to)]);
+    }
+  }
+  extra_distance_.assign(g.slots().size(), 0.0);
+  for (const RoadmapNode& n : g.slots()) {
+    const int r = room_[static_cast<size_t>(n.id)];
+    if (r < 0 || r == vehicle_room_ || static_cast<size_t>(r) >= entry.size()) continue;
+    const double e = entry[static_cast<size_t>(r)];
+    // A room reached without a doorway node next to it (through a gap the rooms' cut missed) has
+    // no way back to charge.
+    if (!std::isfinite(e)) continue;
+    extra_distance_[static_cast<size_t>(n.id)] =
+        rules_.return_weight * std::max(0.0, reach.distance[static_cast<size_t>(n.id)] - e);
+  }
 }
 
 DepStrategy::TierFn SemanticRoomStrategy::tiers(PlanContext& ctx, bool* labelled) {

@@ -117,6 +117,15 @@ class DepStrategy : public Strategy {
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);
 
+  // Called in select_goal right after this cycle's search (last_search() holds it): a subclass
+  // may fill extra_distance_ (m per slot, added to the path length a node is scored with).
+  virtual void searched(PlanContext& /*ctx*/) {}
+  std::vector<double> extra_distance_;
+  double scored_distance(int64_t id) const {
+    const size_t i = static_cast<size_t>(id);
+    return search_.distance[i] + (i < extra_distance_.size() ? extra_distance_[i] : 0.0);
+  }
+
   const Roadmap& graph() const { return graph_; }
   Roadmap& graph() { return graph_; }
   int64_t root() const { return root_; }

@@ -190,6 +190,11 @@ struct RoomConfig {
   bool boundary_gain = false;
   // The paper's Eq. 6 reward on top (as semantic-dep); false: G / T_path alone.
   bool eq6_reward = true;
+  // Look into a room before entering it: a node in a room other than the vehicle's is scored
+  // with its path from the vehicle plus this times its depth beyond the room's doorway (the path
+  // length past the nearest doorway node next to the room), the way back out that a look from
+  // the doorway saves. A dead-end room entered early is flown twice before 85 %; 0: off.
+  double return_weight = 0.0;
 };
 
 // semantic-fuel (semantic_fuel_strategy.hpp; docs/planner.md, "semantic-fuel"): FUEL's tour with

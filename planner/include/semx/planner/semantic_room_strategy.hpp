@@ -14,7 +14,9 @@
 //     room.finish_gain, those nodes outrank every other;
 //   - with room.tour, a global order of rooms: among the rooms with a node of finish_gain, the
 //     first of the shortest open tour through them from the vehicle (roadmap distances between
-//     each room's best node) is the one whose nodes of finish_gain outrank the rest.
+//     each room's best node) is the one whose nodes of finish_gain outrank the rest;
+//   - with room.return_weight, look into a room before entering it: a node of another room is
+//     scored as if the way back out to its doorway were flown too.
 // Below finish_gain everywhere, DEP's ranking decides among all nodes as before. Without door
 // regions and passage nodes the whole roadmap is one room.
 #pragma once
@@ -37,6 +39,8 @@ class SemanticRoomStrategy : public DepStrategy {
   // Per slot of the last cycle: the room of each reachable node (0 the vehicle's, when the
   // vehicle is in one), -1 for doorway nodes and nodes the root does not reach.
   const std::vector<int>& room_of() const { return room_; }
+  // The vehicle's room in the last cycle (0), or -1 when it stands in a doorway.
+  int vehicle_room() const { return vehicle_room_; }
   // The room whose nodes of finish_gain outrank the others in the last cycle, -1 for none.
   int target_room() const { return target_; }
   // Node `id` stands in a doorway this cycle (a boundary between rooms).
@@ -51,9 +55,14 @@ class SemanticRoomStrategy : public DepStrategy {
   // The gain finish_gain is compared with (RoomConfig::boundary_gain).
   double room_gain(const RoadmapNode& n) const;
 
+  // room.return_weight: every node of a room not the vehicle's costs its depth past the room's
+  // doorway (extra_distance_); labels the rooms first.
+  void searched(PlanContext& ctx) override;
+
   RoomConfig rules_;
   std::vector<int> room_;  // per slot
   int target_ = -1;
+  int vehicle_room_ = -1;
 };
 
 }  // namespace semx::planner
