@@ -34,7 +34,8 @@ struct TwoRoomScene : PlanScene {
     r.radius = 3.0;
     return r;
   }
-  Goal choose(DepStrategy& s) {
+  Goal choose(DepStrategy& s, const Eigen::Vector3d& door_node = {4.1, 2.0, 1.2},
+              const Eigen::Vector3d& beyond_node = {5.2, 2.0, 1.2}) {
     s.on_map_reset();
     PlanContext ctx = context({2.5, 1.6, 1.2}, -0.5 * core::kPi);
     ctx.min_gain = config.gain.min_gain;
@@ -42,8 +43,8 @@ struct TwoRoomScene : PlanScene {
     const int64_t root = s.insert_root(ctx);
     s.graph().node(root).blacklisted_until = 10;  // the choice is between the three nodes
     pocket = s.try_insert(ctx, {1.6, 2.4, 1.0});
-    doorway = s.try_insert(ctx, {4.1, 2.0, 1.2});
-    beyond = s.try_insert(ctx, {5.2, 2.0, 1.2});
+    doorway = s.try_insert(ctx, door_node);
+    beyond = s.try_insert(ctx, beyond_node);
     EXPECT_GE(pocket, 0);
     EXPECT_GE(doorway, 0);
     EXPECT_GE(beyond, 0);
@@ -111,6 +112,54 @@ TEST(SemanticRoom, WithoutADoorOrWithLittleLeftInTheRoomItFliesDepsGoal) {
     SemanticRoomStrategy room(s.config);
     EXPECT_EQ(s.choose(room).position, d.position);
   }
+}
+
+// Look into a room before entering it (room.return_weight): a node of a room other than the
+// vehicle's is scored with its depth past the room's doorway added to its path, the way back
+// out; nodes of the vehicle's room and doorway nodes are scored as DEP scores them.
+TEST(SemanticRoom, ANodeInAnotherRoomCostsItsDepthPastTheDoorway) {
+  TwoRoomScene s;
+  s.regions = {TwoRoomScene::door()};
+  s.config.room.finish_gain = 0.0;
+  s.config.room.return_weight = 2.0;
+  SemanticRoomStrategy room(s.config);
+  s.choose(room);
+  const auto& d = room.last_search().distance;
+  const auto i = [](int64_t id) { return static_cast<size_t>(id); };
+  ASSERT_EQ(room.room_of()[i(s.beyond)], 1);
+  ASSERT_EQ(room.vehicle_room(), 0);
+  EXPECT_NEAR(room.scored_distance(s.beyond) - d[i(s.beyond)], 2.0 * (d[i(s.beyond)] - d[i(s.doorway)]),
+              1e-9);
+  EXPECT_GT(room.scored_distance(s.beyond) - d[i(s.beyond)], 1.0);
+  EXPECT_EQ(room.scored_distance(s.doorway), d[i(s.doorway)]);
+  EXPECT_EQ(room.scored_distance(s.pocket), d[i(s.pocket)]);
+}
+
+TEST(SemanticRoom, TheWayBackOutMakesTheDoorwayTheGoalWhereDepEntersTheRoom) {
+  // A doorway node 0.4 m short of the door, where the jambs narrow its view of the second room:
+  // DEP flies 1.3 m on into the room, whose view is twice as large.
+  const Eigen::Vector3d door_node(3.7, 2.0, 1.2), room_node(5.0, 2.0, 1.2);
+  TwoRoomScene base;
+  base.regions = {TwoRoomScene::door()};
+  DepStrategy dep(base.config, false);
+  const Goal d = base.choose(dep, door_node, room_node);
+  ASSERT_TRUE(d.valid);
+  ASSERT_EQ(d.node, base.beyond) << "the scene is meant to make DEP enter the second room";
+  auto room_goal = [&](bool door, double weight) {
+    TwoRoomScene s;
+    if (door) s.regions = {TwoRoomScene::door()};
+    s.config.room.finish_gain = 0.0;
+    s.config.room.eq6_reward = false;
+    s.config.room.return_weight = weight;
+    SemanticRoomStrategy room(s.config);
+    const Goal g = s.choose(room, door_node, room_node);
+    return g.node == s.doorway ? "doorway" : g.node == s.beyond ? "room" : "other";
+  };
+  // The rule off, or no door seen (one room): DEP's goal.
+  EXPECT_STREQ(room_goal(true, 0.0), "room");
+  EXPECT_STREQ(room_goal(false, 5.0), "room");
+  // The way back out charged: a look from the doorway first.
+  EXPECT_STREQ(room_goal(true, 1.0), "doorway");
 }
 
 }  // namespace
