@@ -31,6 +31,21 @@ bool SemanticRoomStrategy::doorway(const PlanContext& ctx, int64_t id) const {
   return false;
 }
 
+bool SemanticRoomStrategy::crosses_door(const PlanContext& ctx, const Eigen::Vector3d& a,
+                                        const Eigen::Vector3d& b) const {
+  if (!rules_.cut_edges || !ctx.regions || !(rules_.door_radius > 0)) return false;
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  const Eigen::Vector2d a2 = a.head<2>(), ab = b.head<2>() - a2;
+  const double len2 = ab.squaredNorm();
+  for (const SemanticRegion& s : *ctx.regions) {
+    if (s.class_id != door || !s.centroid.allFinite()) continue;
+    const Eigen::Vector2d c = s.centroid.head<2>();
+    const double t = len2 > 0 ? std::clamp((c - a2).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    if ((a2 + t * ab - c).squaredNorm() <= rules_.door_radius * rules_.door_radius) return true;
+  }
+  return false;
+}
+
 void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
   const Roadmap& g = graph();
   constexpr int kUnlabelled = -2;
@@ -49,6 +64,7 @@ void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
       for (const RoadmapEdge& e : g.node(id).edges) {
         int& label = room_[static_cast<size_t>(e.to)];
         if (label != kUnlabelled) continue;
+        if (crosses_door(ctx, g.node(id).position, g.node(e.to).position)) continue;
         label = rooms;
         open.push_back(e.to);
       }
@@ -123,15 +139,21 @@ void SemanticRoomStrategy::searched(PlanContext& ctx) {
   label_rooms(ctx);
   const Roadmap& g = graph();
   const Roadmap::Search& reach = last_search();
-  // Each room's entry: the nearest (from the vehicle) doorway node next to one of its nodes.
+  // Each room's entry: the nearest (from the vehicle) way in, a doorway node next to one of its
+  // nodes or its first node across a cut edge.
   std::vector<double> entry;
   for (const RoadmapNode& n : g.slots()) {
     const int r = room_[static_cast<size_t>(n.id)];
     if (r < 0 || r == vehicle_room_) continue;
     if (entry.size() <= static_cast<size_t>(r)) entry.resize(static_cast<size_t>(r) + 1, kInf);
     for (const RoadmapEdge& e : n.edges) {
-      if (room_[static_cast<size_t>(e.to)] != -1 || !reach.reached(e.to)) continue;
-      entry[static_cast<size_t>(r)] = std::min(entry[static_cast<size_t>(r)], reach.distance[static_cast<size_t>(e.to)]);
+      const int other = room_[static_cast<size_t>(e.to)];
+      if (other == r || !reach.reached(e.to)) continue;
+      // Next to a doorway node: the way in is that node. Across a cut edge (another room): the
+      // way in is this node, the first past the doorway.
+      const double in =
+          other == -1 ? reach.distance[static_cast<size_t>(e.to)] : reach.distance[static_cast<size_t>(n.id)];
+      entry[static_cast<size_t>(r)] = std::min(entry[static_cast<size_t>(r)], in);
     }
   }
   extra_distance_.assign(g.slots().size(), 0.0);

@@ -162,5 +162,31 @@ TEST(SemanticRoom, TheWayBackOutMakesTheDoorwayTheGoalWhereDepEntersTheRoom) {
   EXPECT_STREQ(room_goal(true, 1.0), "doorway");
 }
 
+// Edges are up to 2.5 m long: one through the doorway joins a node 1.1 m before the door's
+// centroid to one 1.5 m past it with no node in the doorway, and only room.cut_edges splits them.
+TEST(SemanticRoom, AnEdgeThroughADoorwaySplitsTheRoomsOnlyWithCutEdges) {
+  for (const bool cut : {false, true}) {
+    TwoRoomScene s;
+    s.regions = {TwoRoomScene::door()};
+    s.config.room.finish_gain = 0.0;
+    s.config.room.cut_edges = cut;
+    SemanticRoomStrategy room(s.config);
+    room.on_map_reset();
+    PlanContext ctx = s.context({2.7, 2.0, 1.2}, 0.0);
+    ctx.min_gain = s.config.gain.min_gain;
+    room.process_map_changes(ctx);
+    const int64_t root = room.insert_root(ctx);
+    const int64_t past = room.try_insert(ctx, {4.9, 2.0, 1.2});
+    ASSERT_GE(past, 0);
+    bool joined = false;
+    for (const RoadmapEdge& e : room.graph().node(root).edges) joined = joined || e.to == past;
+    ASSERT_TRUE(joined) << "the scene is meant to join the two nodes by one edge through the doorway";
+    std::string reason;
+    room.select_goal_by_rooms(ctx, &reason);
+    EXPECT_EQ(room.room_of()[static_cast<size_t>(root)], 0);
+    EXPECT_EQ(room.room_of()[static_cast<size_t>(past)], cut ? 1 : 0) << (cut ? "cut" : "not cut");
+  }
+}
+
 }  // namespace
 }  // namespace semx::planner

@@ -195,6 +195,10 @@ struct RoomConfig {
   // length past the nearest doorway node next to the room), the way back out that a look from
   // the doorway saves. A dead-end room entered early is flown twice before 85 %; 0: off.
   double return_weight = 0.0;
+  // An edge that passes within door_radius (horizontally) of a door region's centroid is cut too:
+  // edges are up to roadmap.max_edge_length long, so one can join the nodes on both sides of a
+  // doorway past the nodes that stand in it, and the two rooms would be one.
+  bool cut_edges = false;
 };
 
 // semantic-fuel (semantic_fuel_strategy.hpp; docs/planner.md, "semantic-fuel"): FUEL's tour with

@@ -45,6 +45,8 @@ class SemanticRoomStrategy : public DepStrategy {
   int target_room() const { return target_; }
   // Node `id` stands in a doorway this cycle (a boundary between rooms).
   bool doorway(const PlanContext& ctx, int64_t id) const;
+  // With room.cut_edges: the edge a-b passes through a doorway (within door_radius of a door).
+  bool crosses_door(const PlanContext& ctx, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
  private:
   // Labels the reachable roadmap's rooms and picks the target room (after the cycle's search).
