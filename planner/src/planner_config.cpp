@@ -245,6 +245,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   rm.get("boundary_gain", c.room.boundary_gain);
   rm.get("return_weight", c.room.return_weight, 0.0, 100.0);
   rm.get("cut_edges", c.room.cut_edges);
+  rm.get("dead_ends_only", c.room.dead_ends_only);
   auto sf = m.child("semantic_fuel");
   sf.get("door_radius", c.semantic_fuel.door_radius, 0.0, 10.0);
   sf.get("door_height", c.semantic_fuel.door_height, 0.0, 10.0);

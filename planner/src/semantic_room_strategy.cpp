@@ -4,6 +4,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <set>
 
 #include "semx/planner/tour_solver.hpp"
 #include "semx/runtime/semantic_classes.hpp"
@@ -20,30 +21,37 @@ SemanticRoomStrategy::SemanticRoomStrategy(const PlannerConfig& config)
 bool SemanticRoomStrategy::doorway(const PlanContext& ctx, int64_t id) const {
   const RoadmapNode& n = graph().node(id);
   if (rules_.passages_bound && n.passage) return true;
-  if (!ctx.regions || !(rules_.door_radius > 0)) return false;
-  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
-  const double r2 = rules_.door_radius * rules_.door_radius;
-  for (const SemanticRegion& s : *ctx.regions) {
-    // A door stays a doorway once its leaf is fully observed (active only says the leaf was seen).
-    if (s.class_id != door || !s.centroid.allFinite()) continue;
-    if ((n.position - s.centroid).head<2>().squaredNorm() <= r2) return true;
-  }
-  return false;
+  return door_near(ctx, n.position) >= 0;
 }
 
-bool SemanticRoomStrategy::crosses_door(const PlanContext& ctx, const Eigen::Vector3d& a,
-                                        const Eigen::Vector3d& b) const {
-  if (!rules_.cut_edges || !ctx.regions || !(rules_.door_radius > 0)) return false;
+int SemanticRoomStrategy::door_near(const PlanContext& ctx, const Eigen::Vector3d& p) const {
+  if (!ctx.regions || !(rules_.door_radius > 0)) return -1;
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  const double r2 = rules_.door_radius * rules_.door_radius;
+  for (size_t i = 0; i < ctx.regions->size(); ++i) {
+    const SemanticRegion& s = (*ctx.regions)[i];
+    // A door stays a doorway once its leaf is fully observed (active only says the leaf was seen).
+    if (s.class_id != door || !s.centroid.allFinite()) continue;
+    if ((p - s.centroid).head<2>().squaredNorm() <= r2) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int SemanticRoomStrategy::door_crossed(const PlanContext& ctx, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b) const {
+  if (!rules_.cut_edges || !ctx.regions || !(rules_.door_radius > 0)) return -1;
   const int door = static_cast<int>(runtime::SemanticClass::kDoor);
   const Eigen::Vector2d a2 = a.head<2>(), ab = b.head<2>() - a2;
   const double len2 = ab.squaredNorm();
-  for (const SemanticRegion& s : *ctx.regions) {
+  for (size_t i = 0; i < ctx.regions->size(); ++i) {
+    const SemanticRegion& s = (*ctx.regions)[i];
     if (s.class_id != door || !s.centroid.allFinite()) continue;
     const Eigen::Vector2d c = s.centroid.head<2>();
     const double t = len2 > 0 ? std::clamp((c - a2).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    if ((a2 + t * ab - c).squaredNorm() <= rules_.door_radius * rules_.door_radius) return true;
+    if ((a2 + t * ab - c).squaredNorm() <= rules_.door_radius * rules_.door_radius)
+      return static_cast<int>(i);
   }
-  return false;
+  return -1;
 }
 
 void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
@@ -64,7 +72,7 @@ void SemanticRoomStrategy::label_rooms(PlanContext& ctx) {
       for (const RoadmapEdge& e : g.node(id).edges) {
         int& label = room_[static_cast<size_t>(e.to)];
         if (label != kUnlabelled) continue;
-        if (crosses_door(ctx, g.node(id).position, g.node(e.to).position)) continue;
+        if (door_crossed(ctx, g.node(id).position, g.node(e.to).position) >= 0) continue;
         label = rooms;
         open.push_back(e.to);
       }
@@ -140,12 +148,16 @@ void SemanticRoomStrategy::searched(PlanContext& ctx) {
   const Roadmap& g = graph();
   const Roadmap::Search& reach = last_search();
   // Each room's entry: the nearest (from the vehicle) way in, a doorway node next to one of its
-  // nodes or its first node across a cut edge.
+  // nodes or its first node across a cut edge; and its ways in, told apart by their door.
   std::vector<double> entry;
+  std::vector<std::set<int64_t>> ways;
   for (const RoadmapNode& n : g.slots()) {
     const int r = room_[static_cast<size_t>(n.id)];
     if (r < 0 || r == vehicle_room_) continue;
-    if (entry.size() <= static_cast<size_t>(r)) entry.resize(static_cast<size_t>(r) + 1, kInf);
+    if (entry.size() <= static_cast<size_t>(r)) {
+      entry.resize(static_cast<size_t>(r) + 1, kInf);
+      ways.resize(static_cast<size_t>(r) + 1);
+    }
     for (const RoadmapEdge& e : n.edges) {
       const int other = room_[static_cast<size_t>(e.to)];
       if (other == r || !reach.reached(e.to)) continue;
@@ -154,6 +166,11 @@ void SemanticRoomStrategy::searched(PlanContext& ctx) {
       const double in =
           other == -1 ? reach.distance[static_cast<size_t>(e.to)] : reach.distance[static_cast<size_t>(n.id)];
       entry[static_cast<size_t>(r)] = std::min(entry[static_cast<size_t>(r)], in);
+      if (!rules_.dead_ends_only) continue;
+      const RoadmapNode& m = g.node(e.to);
+      int door = other == -1 ? door_near(ctx, m.position) : door_crossed(ctx, n.position, m.position);
+      // A passage node without a door is a way of its own.
+      ways[static_cast<size_t>(r)].insert(door >= 0 ? door : -1 - e.to);
     }
   }
   extra_distance_.assign(g.slots().size(), 0.0);
@@ -164,6 +181,8 @@ void SemanticRoomStrategy::searched(PlanContext& ctx) {
     // A room reached without a doorway node next to it (through a gap the rooms' cut missed) has
     // no way back to charge.
     if (!std::isfinite(e)) continue;
+    // A room with a second way out known is passed through, not left the way it was entered.
+    if (rules_.dead_ends_only && ways[static_cast<size_t>(r)].size() > 1) continue;
     extra_distance_[static_cast<size_t>(n.id)] =
         rules_.return_weight * std::max(0.0, reach.distance[static_cast<size_t>(n.id)] - e);
   }

@@ -199,6 +199,9 @@ struct RoomConfig {
   // edges are up to roadmap.max_edge_length long, so one can join the nodes on both sides of a
   // doorway past the nodes that stand in it, and the two rooms would be one.
   bool cut_edges = false;
+  // return_weight only for rooms with one way in known (one door or passage next to them): a room
+  // with a second door is flown through, not left the way it was entered.
+  bool dead_ends_only = false;
 };
 
 // semantic-fuel (semantic_fuel_strategy.hpp; docs/planner.md, "semantic-fuel"): FUEL's tour with

@@ -45,8 +45,11 @@ class SemanticRoomStrategy : public DepStrategy {
   int target_room() const { return target_; }
   // Node `id` stands in a doorway this cycle (a boundary between rooms).
   bool doorway(const PlanContext& ctx, int64_t id) const;
-  // With room.cut_edges: the edge a-b passes through a doorway (within door_radius of a door).
-  bool crosses_door(const PlanContext& ctx, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  // The index in ctx.regions of a door region within door_radius (horizontally) of p, -1 for none.
+  int door_near(const PlanContext& ctx, const Eigen::Vector3d& p) const;
+  // With room.cut_edges: the door region (index) the edge a-b passes within door_radius of, -1 for
+  // none (and always without cut_edges).
+  int door_crossed(const PlanContext& ctx, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
  private:
   // Labels the reachable roadmap's rooms and picks the target room (after the cycle's search).
