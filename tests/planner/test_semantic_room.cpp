@@ -17,6 +17,7 @@ namespace {
 // pocket, one in the doorway, one in the second room looking at its unknown part.
 struct TwoRoomScene : PlanScene {
   int64_t pocket = -1, doorway = -1, beyond = -1;
+  std::vector<int64_t> more;
 
   TwoRoomScene() : PlanScene("semantic-room") {
     config.gain.min_gain = 300.0;  // the test rays count fewer voxels than the defaults
@@ -35,7 +36,8 @@ struct TwoRoomScene : PlanScene {
     return r;
   }
   Goal choose(DepStrategy& s, const Eigen::Vector3d& door_node = {4.1, 2.0, 1.2},
-              const Eigen::Vector3d& beyond_node = {5.2, 2.0, 1.2}) {
+              const Eigen::Vector3d& beyond_node = {5.2, 2.0, 1.2},
+              const std::vector<Eigen::Vector3d>& more_nodes = {}) {
     s.on_map_reset();
     PlanContext ctx = context({2.5, 1.6, 1.2}, -0.5 * core::kPi);
     ctx.min_gain = config.gain.min_gain;
@@ -45,6 +47,7 @@ struct TwoRoomScene : PlanScene {
     pocket = s.try_insert(ctx, {1.6, 2.4, 1.0});
     doorway = s.try_insert(ctx, door_node);
     beyond = s.try_insert(ctx, beyond_node);
+    for (const Eigen::Vector3d& p : more_nodes) more.push_back(s.try_insert(ctx, p));
     EXPECT_GE(pocket, 0);
     EXPECT_GE(doorway, 0);
     EXPECT_GE(beyond, 0);
@@ -186,6 +189,34 @@ TEST(SemanticRoom, AnEdgeThroughADoorwaySplitsTheRoomsOnlyWithCutEdges) {
     EXPECT_EQ(room.room_of()[static_cast<size_t>(root)], 0);
     EXPECT_EQ(room.room_of()[static_cast<size_t>(past)], cut ? 1 : 0) << (cut ? "cut" : "not cut");
   }
+}
+
+// room.dead_ends_only: a second door next to the second room (a node in its doorway, joined to
+// the room's node) makes it a room to fly through, and its depth is not charged.
+TEST(SemanticRoom, ARoomWithASecondDoorIsNotChargedTheWayBackWithDeadEndsOnly) {
+  SemanticRegion second = TwoRoomScene::door();
+  second.centroid = Eigen::Vector3d(5.3, 3.3, 1.0);
+  const Eigen::Vector3d second_doorway(5.3, 3.0, 1.2);
+  auto charge = [&](bool dead_ends_only, bool second_door) {
+    TwoRoomScene s;
+    s.regions = {TwoRoomScene::door()};
+    if (second_door) s.regions.push_back(second);
+    s.config.room.finish_gain = 0.0;
+    s.config.room.return_weight = 1.0;
+    s.config.room.dead_ends_only = dead_ends_only;
+    SemanticRoomStrategy room(s.config);
+    s.choose(room, {4.1, 2.0, 1.2}, {5.0, 2.0, 1.2}, {second_doorway});
+    EXPECT_GE(s.more.at(0), 0);
+    EXPECT_EQ(room.room_of()[static_cast<size_t>(s.beyond)], 1);
+    EXPECT_EQ(room.room_of()[static_cast<size_t>(s.more.at(0))], second_door ? -1 : 1);
+    bool joined = false;
+    for (const RoadmapEdge& e : room.graph().node(s.beyond).edges) joined = joined || e.to == s.more.at(0);
+    EXPECT_TRUE(joined) << "the scene is meant to join the room's node to the second doorway";
+    return room.scored_distance(s.beyond) - room.last_search().distance[static_cast<size_t>(s.beyond)];
+  };
+  EXPECT_GT(charge(true, false), 0.5);  // one door: a dead end
+  EXPECT_GT(charge(false, true), 0.5);  // two doors, every room charged
+  EXPECT_EQ(charge(true, true), 0.0);   // two doors, dead ends only
 }
 
 }  // namespace
