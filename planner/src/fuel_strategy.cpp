@@ -475,9 +475,18 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
             latency_weight(ctx, *clusters_.find(sites_[static_cast<size_t>(i)].cluster), w);
       }
     }
+    double total_weight = 0.0;
+    for (const double w : weight) total_weight += w;
+    // The latency tour's cost: the weighted latency, and with latency_quota the time to that share.
+    const auto judged = [&](const std::vector<int>& o) {
+      double c = latency_cost(problem, o, weight);
+      if (f.latency_quota > 0)
+        c += f.quota_weight * total_weight * quota_time(problem, o, weight, f.latency_quota);
+      return c;
+    };
     auto by_latency = [&](Tour t, bool keep_first) {
       if (t.order.size() < 2) {
-        t.cost = latency_cost(problem, t.order, weight);
+        t.cost = judged(t.order);
         return t;
       }
       const int head = t.order.front();
@@ -489,12 +498,10 @@ std::optional<FuelStrategy::Planned> FuelStrategy::plan_tour(PlanContext& ctx, i
         o.insert(o.end(), r.begin(), r.end());
         return o;
       };
-      const auto objective = [&](const std::vector<int>& r) {
-        return latency_cost(problem, whole(r), weight);
-      };
+      const auto objective = [&](const std::vector<int>& r) { return judged(whole(r)); };
       rest = improve_order(rest, objective, f.latency_evaluations, false);
       t.order = whole(rest);
-      t.cost = latency_cost(problem, t.order, weight);
+      t.cost = judged(t.order);
       return t;
     };
     Tour tour = solve_open_tour(problem, f.exact_tour_max);

@@ -213,6 +213,8 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   f.get("latency_gain", fu.latency_gain);
   f.get("latency_gain_power", fu.latency_gain_power, 0.1, 10.0);
   f.get("rate_first", fu.rate_first);
+  f.get("latency_quota", fu.latency_quota, 0.0, 1.0);
+  f.get("quota_weight", fu.quota_weight, 0.0, 1e6);
   f.get("square_clearance", fu.square_clearance, 0.0, 10.0);
   f.get("search_step", fu.search_step, 1, 8);
   f.get("low_clearance_penalty", fu.low_clearance_penalty, 0.0, 100.0);

@@ -188,6 +188,23 @@ double latency_cost(const TourProblem& p, const std::vector<int>& order, const s
   return sum;
 }
 
+double quota_time(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight,
+                  double share) {
+  double total = 0.0;
+  for (const int v : order) total += weight[static_cast<std::size_t>(v)];
+  if (!(total > 0)) return 0.0;
+  double t = 0.0, seen = 0.0;
+  int at = 0;
+  for (const int v : order) {
+    t += p.at(at, v);
+    seen += weight[static_cast<std::size_t>(v)];
+    at = v;
+    // A relative tolerance: the shares of a tour's weights summed in another order must agree.
+    if (seen >= share * total * (1.0 - 1e-12)) break;
+  }
+  return t;
+}
+
 int highest_rate_node(const TourProblem& p, const std::vector<double>& weight) {
   int best = -1;
   double best_rate = -1.0;

@@ -285,6 +285,30 @@ TEST(TourSolver, TheHighestRateNodeIsTheMostSeenPerSecondOfTheFirstLeg) {
   EXPECT_EQ(highest_rate_node(none, {0.0}), -1);
 }
 
+TEST(TourSolver, TheQuotaTimeIsWhenTheVisitedWeightFirstReachesTheShare) {
+  // A small site 1 s away on the other side from a large one 4 s away (4.5 s between them): the
+  // latency order takes the small one first (3 x 1 + 10 x 5.5 = 58 against 10 x 4 + 3 x 8.5 = 65.5);
+  // 70 % of the weight (9.1 of 13) is seen at 5.5 s that way, at 4 s the other way.
+  TourProblem p;
+  p.n = 3;
+  p.cost = {0, 1, 4, 1, 0, 4.5, 4, 4.5, 0};
+  const std::vector<double> weight = {0.0, 3.0, 10.0};
+  EXPECT_LT(latency_cost(p, {1, 2}, weight), latency_cost(p, {2, 1}, weight));
+  EXPECT_DOUBLE_EQ(quota_time(p, {1, 2}, weight, 0.7), 5.5);
+  EXPECT_DOUBLE_EQ(quota_time(p, {2, 1}, weight, 0.7), 4.0);
+  // A share the small site alone reaches; the whole weight; nothing to see.
+  EXPECT_DOUBLE_EQ(quota_time(p, {1, 2}, weight, 0.2), 1.0);
+  EXPECT_DOUBLE_EQ(quota_time(p, {2, 1}, weight, 1.0), 8.5);
+  EXPECT_DOUBLE_EQ(quota_time(p, {}, weight, 0.7), 0.0);
+  EXPECT_DOUBLE_EQ(quota_time(p, {1, 2}, {0.0, 0.0, 0.0}, 0.7), 0.0);
+  // Judged on both, as fuel.latency_quota does with a weight of 10: the large site first.
+  const double total = 13.0;
+  auto judged = [&](const std::vector<int>& o) {
+    return latency_cost(p, o, weight) + 10.0 * total * quota_time(p, o, weight, 0.7);
+  };
+  EXPECT_LT(judged({2, 1}), judged({1, 2}));
+}
+
 TEST(TourSolver, TheLatencyOrderFromTheShortestTourIsNearTheBest) {
   // Random asymmetric costs and weights: the local moves from the shortest tour never do worse
   // than it, and come within a few per cent of the brute-force best order on the mean.

@@ -33,6 +33,11 @@ double open_path_cost(const TourProblem& p, const std::vector<int>& order);
 // times the cost of the path up to that node (what a tour that should see the most soonest
 // minimises, where open_path_cost is the time to see everything).
 double latency_cost(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight);
+// The cost of the path up to the node of `order` at which the visited nodes' weight first reaches
+// `share` of the weight of all of `order`'s nodes (0 for an empty order or no weight): the time a
+// tour takes to show that share, which the weighted latency only approximates.
+double quota_time(const TourProblem& p, const std::vector<int>& order, const std::vector<double>& weight,
+                  double share);
 // The node (1..n-1) of the highest rate weight[node] / cost from node 0 (a greedy planner's next
 // goal: the most seen per second of flight), the first of equals; -1 when there is none.
 int highest_rate_node(const TourProblem& p, const std::vector<double>& weight);
