@@ -193,7 +193,9 @@ struct RoomConfig {
   // Look into a room before entering it: a node in a room other than the vehicle's is scored
   // with its path from the vehicle plus this times its depth beyond the room's doorway (the path
   // length past the nearest doorway node next to the room), the way back out that a look from
-  // the doorway saves. A dead-end room entered early is flown twice before 85 %; 0: off.
+  // the doorway saves. A dead-end room entered early is flown twice before 85 %; 0: off. The main
+  // loop's switch test (hysteresis) re-scores the flown goal without it: a goal once chosen in
+  // another room is not given up for the way back it was charged.
   double return_weight = 0.0;
   // An edge that passes within door_radius (horizontally) of a door region's centroid is cut too:
   // edges are up to roadmap.max_edge_length long, so one can join the nodes on both sides of a
