@@ -143,7 +143,8 @@ void SemanticRoomStrategy::choose_target(PlanContext& ctx, int rooms) {
 }
 
 void SemanticRoomStrategy::searched(PlanContext& ctx) {
-  if (!(rules_.return_weight > 0)) return;
+  labelled_in_search_ = rules_.return_weight > 0;
+  if (!labelled_in_search_) return;
   label_rooms(ctx);
   const Roadmap& g = graph();
   const Roadmap::Search& reach = last_search();
@@ -189,10 +190,11 @@ void SemanticRoomStrategy::searched(PlanContext& ctx) {
 }
 
 DepStrategy::TierFn SemanticRoomStrategy::tiers(PlanContext& ctx, bool* labelled) {
-  // Asked for after select_goal's search: the rooms are labelled on first use.
+  // Asked for after select_goal's search: the rooms are labelled on first use, unless searched()
+  // labelled them for this search already.
   return [this, &ctx, labelled](int64_t id) {
     if (!*labelled) {
-      label_rooms(ctx);
+      if (!labelled_in_search_) label_rooms(ctx);
       *labelled = true;
     }
     if (target_ < 0 || room_[static_cast<size_t>(id)] != target_) return 0;

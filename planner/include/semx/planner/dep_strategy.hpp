@@ -117,10 +117,7 @@ class DepStrategy : public Strategy {
   ScoreFn paper_score() const;
   void evaluate_gain(PlanContext& ctx, int64_t id);
 
-  // Called in select_goal right after this cycle's search (last_search() holds it): a subclass
-  // may fill extra_distance_ (m per slot, added to the path length a node is scored with).
-  virtual void searched(PlanContext& /*ctx*/) {}
-  std::vector<double> extra_distance_;
+  // The path length node `id` is scored with: this cycle's search plus what searched() added.
   double scored_distance(int64_t id) const {
     const size_t i = static_cast<size_t>(id);
     return search_.distance[i] + (i < extra_distance_.size() ? extra_distance_[i] : 0.0);
@@ -133,6 +130,12 @@ class DepStrategy : public Strategy {
   const Roadmap::Search& last_search() const { return search_; }
   CollisionChecker& checker() { return checker_; }
   GainEvaluator& gains() { return gains_; }
+
+ protected:
+  // Called in select_goal right after this cycle's search (last_search() holds it): a subclass
+  // may fill extra_distance_ (m per slot, added to the path length a node is scored with).
+  virtual void searched(PlanContext& /*ctx*/) {}
+  std::vector<double> extra_distance_;
 
  private:
   // What a node is scored with: a yaw, the gain counted for it, and the score.

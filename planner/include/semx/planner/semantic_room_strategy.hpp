@@ -68,6 +68,7 @@ class SemanticRoomStrategy : public DepStrategy {
   std::vector<int> room_;  // per slot
   int target_ = -1;
   int vehicle_room_ = -1;
+  bool labelled_in_search_ = false;  // searched() labelled the rooms for this cycle's search
 };
 
 }  // namespace semx::planner
