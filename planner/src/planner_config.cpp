@@ -233,6 +233,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   o.get("target_share", c.oracle.target_share, 0.0, 1.0);
   o.get("early_share", c.oracle.early_share, 0.0, 1.0);
   o.get("improve_evaluations", c.oracle.improve_evaluations, 0, 1000000);
+  o.get("early_first_slack", c.oracle.early_first_slack, -1.0, 10.0);
   o.get("max_attempts", c.oracle.max_attempts, 1, 1000);
   o.get("needed_voxels", c.oracle.needed_voxels, 1, 1000000);
   o.get("chain", c.oracle.chain, 1, 1000);
