@@ -455,7 +455,8 @@ std::string OracleSummary::describe() const {
   s << "oracle (reads the ground truth): |T| " << target << "; " << candidates << " candidate viewpoints see "
     << 100.0 * observable_share() << " % of T (the observable part); " << viewpoints << " viewpoints ("
     << first_pass << " in the first pass, e " << first_pass_exponent
-    << (first_pass_toured ? " toured" : " walked") << (first_pass_improved ? ", reordered" : "")
+    << (first_pass_toured ? " toured" : " walked")
+    << (first_pass_improved ? (first_pass_early_first ? ", reordered early share first" : ", reordered") : "")
     << ", modelled " << first_pass_early_time << " / " << first_pass_target_time
     << " s to the early / target share";
   if (first_pass_improved) s << " (sum " << first_pass_before_improvement << " s before reordering)";
@@ -672,6 +673,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     double exponent = 0.0;
     bool toured = false;
     bool improved = false;  // reordered by the model's times (3b)
+    bool early_first = false;  // ... for the early time first (oracle.early_first_slack)
     double before = 0.0;    // s, its score before that
   };
   const auto want = static_cast<int64_t>(std::ceil(std::min(
@@ -1053,21 +1055,10 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     const std::vector<int> better = improve_order(order, sum, oc.improve_evaluations, true);
     if (sum(better) < before - 1e-9) out[0] = schedule_of(better, base.score());
     if (oc.early_first_slack < 0.0) return out;
-    // Early share first: no view dropped here (one after early_share does not count, and the
-    // second search needs it for target_share), then the rest of the order for target_share
-    // with the early time held within the slack (beyond it, each second counts a thousand).
-    const std::vector<int> soon = improve_order(
-        order, [&](const std::vector<int>& o) { return times(o, true).first; }, oc.improve_evaluations, false);
-    const double cap = times(soon, true).first * (1.0 + oc.early_first_slack);
-    if (!std::isfinite(cap)) return out;
-    const std::vector<int> held = improve_order(
-        soon,
-        [&](const std::vector<int>& o) {
-          const auto [e, t] = times(o, false);
-          return t + (e > cap ? 1e3 * (e - cap) : 0.0);
-        },
-        oc.improve_evaluations, true);
+    const std::vector<int> held =
+        improve_order_first_then_second(order, times, oc.improve_evaluations, oc.early_first_slack);
     out.push_back(schedule_of(held, base.score()));
+    out.back().early_first = true;
     return out;
   };
   Schedule best;
@@ -1083,22 +1074,12 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
       for (Schedule& sc : pool)
         if (best.views.empty() || sc.score() < best.score() - 1e-9) best = std::move(sc);
     } else {
-      // The schedule nearest the best of both times: the lowest of its worse ratio to the
-      // soonest early and the soonest target time of any schedule, ties by the sum. Chosen for
-      // the sum alone, env3's oracle reached 85 % at 69 s where the schedule chosen for that
-      // time alone reached it at 47 s (and 95 % at 140 against 94 s).
-      double e_min = std::numeric_limits<double>::infinity(), t_min = e_min;
-      for (const Schedule& sc : pool) e_min = std::min(e_min, sc.early_time), t_min = std::min(t_min, sc.target_time);
-      auto ratio = [](double x, double lowest) {
-        return std::isfinite(lowest) ? x / std::max(lowest, 1e-6) : (std::isfinite(x) ? 1.0 : 2.0);
-      };
-      auto worse = [&](const Schedule& sc) {
-        return std::max(ratio(sc.early_time, e_min), ratio(sc.target_time, t_min));
-      };
-      for (Schedule& sc : pool)
-        if (best.views.empty() || worse(sc) < worse(best) - 1e-9 ||
-            (worse(sc) < worse(best) + 1e-9 && sc.score() < best.score() - 1e-9))
-          best = std::move(sc);
+      // The schedule nearest the best of both times. Chosen for the sum alone, env3's oracle
+      // reached 85 % at 69 s where the schedule chosen for that time alone reached it at 47 s
+      // (and 95 % at 140 against 94 s).
+      std::vector<std::pair<double, double>> both;
+      for (const Schedule& sc : pool) both.emplace_back(sc.early_time, sc.target_time);
+      best = std::move(pool[static_cast<size_t>(nearest_best_of_both(both))]);
     }
   }
   summary_.first_pass_before_improvement = best.before;
@@ -1110,6 +1091,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   summary_.first_pass_exponent = best.exponent;
   summary_.first_pass_toured = best.toured;
   summary_.first_pass_improved = best.improved;
+  summary_.first_pass_early_first = best.early_first;
   summary_.first_pass_target_time = best.target_time;
   summary_.first_pass_early_time = best.early_time;
 

@@ -1,6 +1,7 @@
 #include "semx/planner/tour_solver.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace semx::planner {
@@ -273,6 +274,44 @@ std::vector<int> improve_order(std::vector<int> order,
       }
   }
   return order;
+}
+
+std::vector<int> improve_order_first_then_second(const std::vector<int>& order, const TwoTimes& times,
+                                                 int max_evaluations, double slack) {
+  const std::vector<int> soon = improve_order(
+      order, [&](const std::vector<int>& o) { return times(o, true).first; }, max_evaluations, false);
+  const double cap = times(soon, true).first * (1.0 + slack);
+  if (!std::isfinite(cap)) return soon;
+  return improve_order(
+      soon,
+      [&](const std::vector<int>& o) {
+        const auto [first, second] = times(o, false);
+        return first > cap ? std::numeric_limits<double>::infinity() : second;
+      },
+      max_evaluations, true);
+}
+
+int nearest_best_of_both(const std::vector<std::pair<double, double>>& times) {
+  double first = std::numeric_limits<double>::infinity(), second = first;
+  for (const auto& [a, b] : times) first = std::min(first, a), second = std::min(second, b);
+  // A column never finite ranks every pair alike on it; an infinite time against a finite best
+  // ranks last.
+  auto ratio = [](double x, double lowest) {
+    if (!std::isfinite(lowest)) return 1.0;
+    return std::isfinite(x) ? x / std::max(lowest, 1e-9) : std::numeric_limits<double>::infinity();
+  };
+  int best = -1;
+  double best_worse = 0.0, best_sum = 0.0;
+  for (size_t i = 0; i < times.size(); ++i) {
+    const double worse = std::max(ratio(times[i].first, first), ratio(times[i].second, second));
+    const double sum = times[i].first + times[i].second;
+    if (best < 0 || worse < best_worse - 1e-9 || (worse < best_worse + 1e-9 && sum < best_sum - 1e-9)) {
+      best = static_cast<int>(i);
+      best_worse = worse;
+      best_sum = sum;
+    }
+  }
+  return best;
 }
 
 }  // namespace semx::planner

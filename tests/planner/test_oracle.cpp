@@ -293,6 +293,61 @@ TEST(OracleTour, ReorderingNeverWorsensAndOftenFindsTheBestOrder) {
   EXPECT_GE(optimal, trials * 3 / 5) << "of " << trials;
 }
 
+TEST(OracleTour, TheEarlyShareFirstGivesUpLittleOfTheTargetTimeWhereTheSumGivesUpMuchOfTheEarly) {
+  // On a line: 6 elements at -1 and at +2.5, 1 at -10; 6 wanted early, all 13 later. Judged on
+  // the sum the best order goes right first (+2.5, -1, -10: 2.5 and 15 s); the early share first
+  // goes left (-1 at 1 s), then right and back (+2.5, -10: all at 17 s).
+  const std::vector<double> x = {0.0, -1.0, 2.5, -10.0};
+  const std::vector<int> gain = {0, 6, 6, 1};
+  const TwoTimes times = [&](const std::vector<int>& o, bool first_only) {
+    const double first = time_to_quota(x, gain, 6, o);
+    return std::make_pair(
+        first, first_only ? std::numeric_limits<double>::infinity() : time_to_quota(x, gain, 13, o));
+  };
+  const std::vector<int> start = {1, 3, 2};
+  auto sum = [&](const std::vector<int>& o) { return times(o, false).first + times(o, false).second; };
+  const std::vector<int> by_sum = improve_order(start, sum, 1000, true);
+  EXPECT_NEAR(times(by_sum, false).first, 2.5, 1e-12);
+  EXPECT_NEAR(times(by_sum, false).second, 15.0, 1e-12);
+  const std::vector<int> early_first = improve_order_first_then_second(start, times, 1000, 0.05);
+  EXPECT_NEAR(times(early_first, false).first, 1.0, 1e-12);
+  EXPECT_NEAR(times(early_first, false).second, 17.0, 1e-12);
+  // With room for the early time to grow to 2.5 s, the right side first again.
+  const std::vector<int> loose = improve_order_first_then_second(start, times, 1000, 1.6);
+  EXPECT_NEAR(times(loose, false).second, 15.0, 1e-12);
+  // The nearer of the two to the best of both: 1 / 17 s (17 is 13 % above 15; 2.5 is 150 % above 1).
+  EXPECT_EQ(nearest_best_of_both({{2.5, 15.0}, {1.0, 17.0}}), 1);
+  EXPECT_EQ(nearest_best_of_both({{1.1, 15.0}, {1.0, 17.0}}), 0);
+  EXPECT_EQ(nearest_best_of_both({{1.0, 17.0}, {1.0, 15.0}, {1.0, 15.0}}), 1);  // the first of equals
+  EXPECT_EQ(nearest_best_of_both({{1.0, std::numeric_limits<double>::infinity()}, {2.0, 30.0}}), 1);
+  EXPECT_EQ(nearest_best_of_both({}), -1);
+}
+
+TEST(OracleTour, TheEarlyShareFirstHoldsItsEarlyTimeAndNeverWorsensItsTargetTime) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::uniform_int_distribution<int> g(1, 20);
+  for (int n = 3; n <= 8; ++n)
+    for (int trial = 0; trial < 10; ++trial) {
+      std::vector<double> x{0.0};
+      std::vector<int> gain{0};
+      int total = 0;
+      for (int i = 1; i < n; ++i) x.push_back(u(rng)), gain.push_back(g(rng)), total += gain.back();
+      const int early = std::max(1, total * 17 / 20), target = std::max(1, total * 19 / 20);
+      const TwoTimes times = [&](const std::vector<int>& o, bool) {
+        return std::make_pair(time_to_quota(x, gain, early, o), time_to_quota(x, gain, target, o));
+      };
+      std::vector<int> order(static_cast<size_t>(n - 1));
+      std::iota(order.begin(), order.end(), 1);
+      auto first = [&](const std::vector<int>& o) { return times(o, true).first; };
+      const std::vector<int> soon = improve_order(order, first, 100000, false);
+      const std::vector<int> held = improve_order_first_then_second(order, times, 100000, 0.1);
+      EXPECT_LE(times(held, false).first, 1.1 * first(soon) + 1e-9);
+      EXPECT_LE(times(held, false).second, times(soon, false).second + 1e-9);
+      EXPECT_GE(times(held, false).first, brute_force_quota(x, gain, early) - 1e-9);
+    }
+}
+
 // ---- the oracle on a tiny world ----------------------------------------------------------------
 
 // A 3.5 x 3 x 2.2 m room with a low table in one corner: a few candidates on a coarse lattice.

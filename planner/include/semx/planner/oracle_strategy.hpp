@@ -57,6 +57,7 @@ struct OracleSummary {
   double first_pass_exponent = 0.0;  // the e of its ratio, and whether it is flown as a tour
   bool first_pass_toured = false;
   bool first_pass_improved = false;            // reordered by the model's time to the target share
+  bool first_pass_early_first = false;         // ... to the early share first (oracle.early_first_slack)
   double first_pass_before_improvement = 0.0;  // s, the model's two times summed before that
   double first_pass_target_time = 0.0;         // s, when it shows oracle.target_share of T by the model
   double first_pass_early_time = 0.0;          // s, ... oracle.early_share
