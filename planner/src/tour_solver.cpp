@@ -276,17 +276,13 @@ std::vector<int> improve_order(std::vector<int> order,
   return order;
 }
 
-std::vector<int> improve_order_first_then_second(const std::vector<int>& order, const TwoTimes& times,
-                                                 int max_evaluations, double slack) {
-  const std::vector<int> soon = improve_order(
-      order, [&](const std::vector<int>& o) { return times(o, true).first; }, max_evaluations, false);
-  const double cap = times(soon, true).first * (1.0 + slack);
-  if (!std::isfinite(cap)) return soon;
+std::vector<int> improve_order_within(const std::vector<int>& order, const TwoTimes& times,
+                                      int max_evaluations, double first_cap) {
   return improve_order(
-      soon,
+      order,
       [&](const std::vector<int>& o) {
         const auto [first, second] = times(o, false);
-        return first > cap ? std::numeric_limits<double>::infinity() : second;
+        return first > first_cap ? std::numeric_limits<double>::infinity() : second;
       },
       max_evaluations, true);
 }

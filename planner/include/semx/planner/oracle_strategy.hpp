@@ -61,6 +61,9 @@ struct OracleSummary {
   double first_pass_before_improvement = 0.0;  // s, the model's two times summed before that
   double first_pass_target_time = 0.0;         // s, when it shows oracle.target_share of T by the model
   double first_pass_early_time = 0.0;          // s, ... oracle.early_share
+  // With oracle.early_first_slack >= 0, every schedule the choice was made from, with its
+  // modelled times to the early and the target share: what one flight gives up of each.
+  std::string schedules;
   double tour_time = 0.0;                      // s, the tour's summed leg costs
   double tour_length = 0.0;                    // m
   bool tour_exact = false;

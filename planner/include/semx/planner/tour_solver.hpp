@@ -68,12 +68,11 @@ std::vector<int> improve_order(std::vector<int> order,
 // never). With `first_only` the caller may stop once the first is known and leave the second
 // infinite.
 using TwoTimes = std::function<std::pair<double, double>(const std::vector<int>&, bool first_only)>;
-// improve_order for the first time alone, every stop kept (one that comes after the first time
-// does not count for it, and the second search needs it), then for the second time while the
-// first stays within `slack` (a share) of what the first search reached. What a schedule chosen
-// for the sum of the two times gives up: env3's oracle reached 85 % at 69 s where 47 s can be had.
-std::vector<int> improve_order_first_then_second(const std::vector<int>& order, const TwoTimes& times,
-                                                 int max_evaluations, double slack);
+// improve_order for the second time among the orders whose first time is at most `first_cap`
+// (an order above it is never taken): a schedule chosen for the sum of the two times gives up much
+// of the first (env3's oracle reached 85 % at 69 s where 47 s can be had).
+std::vector<int> improve_order_within(const std::vector<int>& order, const TwoTimes& times,
+                                      int max_evaluations, double first_cap);
 // Of (first, second) time pairs, the index of the one nearest the best of both: the lowest of its
 // worse ratio to the lowest first and to the lowest second time, ties by the sum; -1 when empty.
 int nearest_best_of_both(const std::vector<std::pair<double, double>>& times);
