@@ -767,7 +767,7 @@ void DepStrategy::sample(PlanContext& ctx, double frontier_fraction, int attempt
 DepStrategy::ScoreFn DepStrategy::paper_score() const {
   const CostConfig cost = config_.cost;
   return [cost](double gain, double reward, double distance, double yaw_change) {
-    return node_score(gain, reward, travel_time(distance, yaw_change, cost));
+    return node_score(gain, reward, travel_time(distance, yaw_change, cost), cost.time_exponent);
   };
 }
 
@@ -786,7 +786,8 @@ std::optional<double> DepStrategy::goal_score(PlanContext& ctx, const Goal& goal
   const double g = gains_.goal_gain(n.gain, ctx.pose.yaw, goal.yaw);
   return node_score(
       g, reward,
-      travel_time(search_.distance[static_cast<size_t>(goal.node)], ctx.pose.yaw, goal.yaw, config_.cost));
+      travel_time(search_.distance[static_cast<size_t>(goal.node)], ctx.pose.yaw, goal.yaw, config_.cost),
+      config_.cost.time_exponent);
 }
 
 void DepStrategy::reject_goal(const Goal& goal, int64_t until_cycle) {

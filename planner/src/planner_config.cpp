@@ -123,6 +123,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   k.get("yaw_rate", c.cost.yaw_rate, 1e-3, 100.0);
   k.get("yaw_weight", c.cost.yaw_weight, 0.0, 1e6);
   k.get("min_time", c.cost.min_time, 1e-6, 1e6);
+  k.get("time_exponent", c.cost.time_exponent, 0.0, 4.0);
   k.get("turn_while_flying", c.cost.turn_while_flying);
   k.get("local_first", c.cost.local_first, 0.0, 1e6);
 

@@ -146,6 +146,10 @@ struct CostConfig {
   // small leftovers near the vehicle are finished before it leaves them behind (the end game:
   // docs/planner.md). 0: the paper's rule, the best score anywhere.
   double local_first = 0.0;
+  // e of Score = (G + R_sem) / T_path^e. Below 1 a large gain farther away outranks the small
+  // leftovers next to the vehicle more readily (the oracle's greedy walks use 0.5 and 1; docs/planner.md,
+  // "Travel cost and score"). 1: the paper's score.
+  double time_exponent = 1.0;
 };
 
 // The semantic reward R_sem (semantic_reward.hpp); only semantic-dep uses it.

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "semx/core/angles.hpp"
@@ -35,6 +36,9 @@ inline double path_length(const std::vector<Eigen::Vector3d>& path) {
   return length;
 }
 
-inline double node_score(double gain, double reward, double time) { return (gain + reward) / time; }
+// With `exponent` (CostConfig::time_exponent) T_path^e; 1 is the paper's Eq. 9.
+inline double node_score(double gain, double reward, double time, double exponent = 1.0) {
+  return (gain + reward) / (exponent == 1.0 ? time : std::pow(time, exponent));
+}
 
 }  // namespace semx::planner
