@@ -124,5 +124,16 @@ TEST(Score, OrdersByUtilityOverTime) {
   EXPECT_GT(far_big, node_score(100, 0, travel_time(2.0, core::kPi, sum)));
 }
 
+TEST(Score, ATimeExponentBelowOnePutsTheLargeGainFartherAwayFirst) {
+  const CostConfig c;
+  // e = 1 (the paper): 100 at 2 s (50) before 300 at 10 s (30); e = 0.5: 70.7 after 94.9.
+  EXPECT_GT(node_score(100, 0, travel_time(2.0, 0.0, c), 1.0),
+            node_score(300, 0, travel_time(10.0, 0.0, c), 1.0));
+  EXPECT_NEAR(node_score(100, 0, 2.0, 0.5), 100.0 / std::sqrt(2.0), 1e-12);
+  EXPECT_LT(node_score(100, 0, travel_time(2.0, 0.0, c), 0.5),
+            node_score(300, 0, travel_time(10.0, 0.0, c), 0.5));
+  EXPECT_EQ(node_score(100, 20, 3.0), node_score(100, 20, 3.0, 1.0));
+}
+
 }  // namespace
 }  // namespace semx::planner
