@@ -906,9 +906,6 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
   // shortest tour through a walk's views may leave its largest view for last, the walk may take
   // small views near the vehicle before a large one across the flat (env2 at 3b6d6b3: 46 % to
   // 51 % of T in 17 s before the room that holds 40 %).
-  // Returns the base reordered for the sum of the model's two times, and with
-  // oracle.early_first_slack >= 0 a second order: for the time to early_share alone, then for the
-  // time to target_share while that stays within the slack of it.
   // How a schedule is reordered: for the sum of the two times; for the early time alone; for the
   // target time with the early time held at most `cap`.
   enum class Judge { sum, early, held };
@@ -1125,7 +1122,9 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     } else {
       // The schedule nearest the best of both times. Chosen for the sum alone, env3's oracle
       // reached 85 % at 69 s where the schedule chosen for that time alone reached it at 47 s
-      // (and 95 % at 140 against 94 s).
+      // (and 95 % at 140 against 94 s). Measured, it found no schedule with both (env3: the
+      // nearest flew 64 / 94 s against the sum's 64 / 81 s, docs/planner.md "One flight, two
+      // times"), so the option is off and the log's list of schedules is what it is for.
       std::vector<std::pair<double, double>> both;
       for (const Schedule& sc : pool) both.emplace_back(sc.early_time, sc.target_time);
       std::ostringstream listed;
