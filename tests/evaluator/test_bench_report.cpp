@@ -166,11 +166,13 @@ TEST(BenchReport, EveryPlannerIsDividedByTheOracleAndTheEndGameIsTabled) {
   write_run(root, "env2", "dep", 1, 200, 30, std::nullopt, true, 40, 100);
   write_run(root, "env2", "dep", 2, 200, 30, std::nullopt, true, 60, 120);
   write_run(root, "env2", "nbv", 1, 300, std::nullopt, std::nullopt, true);
+  write_run(root, "env2", "fuel", 1, 40, 8, std::nullopt, true, 25, 1);  // sooner to 85 %, not to 95 %
   const auto runs = load_bench_runs(root);
-  ASSERT_EQ(runs.size(), 4u);
+  ASSERT_EQ(runs.size(), 5u);
   const std::string md = bench_markdown(runs);
-  EXPECT_NE(md.find("| env2 | dep | 3.00 | 2.50 | 4.00 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| env2 | nbv | N/A | N/A | 6.00 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | dep | 3.00 | 2.50 | 4.00 | 0 / 0 of 2 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | nbv | N/A | N/A | 6.00 | 0 / 0 of 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| env2 | fuel | 0.80 | 1.25 | 0.80 | 1 / 0 of 1 |"), std::string::npos) << md;
   EXPECT_EQ(md.find("| env2 | oracle | N/A"), std::string::npos) << md;  // not divided by itself
   // The comparison table ends with Time_95 and the end game.
   EXPECT_NE(md.find("| 50.00 ± 14.14 | 110.00 ± 14.14 |"), std::string::npos) << md;
