@@ -783,23 +783,27 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
     std::vector<int32_t> parent;
     std::vector<int64_t> gains(static_cast<size_t>(bins));
     std::vector<int> counted(groups, -1);  // the step at which a candidate was last counted
+    // Flies to view (g, b) from `cur` by the last search: what it shows, the clock, the leg.
+    auto take = [&](int g, int b) {
+      source.elements(g, els);
+      for (const MaskedElement& e : els)
+        if ((e.members >> b & 1u) && !sc.shown[static_cast<size_t>(e.element)])
+          sc.shown[static_cast<size_t>(e.element)] = 1, ++have;
+      const int64_t to = m.candidates[static_cast<size_t>(g)];
+      const double l = len[static_cast<size_t>(to)];
+      clock += travel_time(l, cur_yaw, yaw_of(b), config_.cost);
+      sc.views.emplace_back(g, b);
+      sc.have_after.push_back(have);
+      sc.arrival.push_back(clock);
+      sc.leg_length.push_back(l);
+      sc.legs.push_back(cell_path(cur, to, parent));
+      cur = to;
+      cur_yaw = yaw_of(b);
+    };
     for (int step = 0; have < want; ++step) {
       m.search(cur, -1, len, &parent);
       if (static_cast<size_t>(step) < head.size()) {
-        const auto [g, b] = head[static_cast<size_t>(step)];
-        source.elements(g, els);
-        for (const MaskedElement& e : els)
-          if ((e.members >> b & 1u) && !sc.shown[static_cast<size_t>(e.element)])
-            sc.shown[static_cast<size_t>(e.element)] = 1, ++have;
-        const double l = len[static_cast<size_t>(m.candidates[static_cast<size_t>(g)])];
-        clock += travel_time(l, cur_yaw, yaw_of(b), config_.cost);
-        sc.views.emplace_back(g, b);
-        sc.have_after.push_back(have);
-        sc.arrival.push_back(clock);
-        sc.leg_length.push_back(l);
-        sc.legs.push_back(cell_path(cur, m.candidates[static_cast<size_t>(g)], parent));
-        cur = m.candidates[static_cast<size_t>(g)];
-        cur_yaw = yaw_of(b);
+        take(head[static_cast<size_t>(step)].first, head[static_cast<size_t>(step)].second);
         continue;
       }
       // The ratio's denominator: the travel time to the power e (< 1 favours the larger views
@@ -841,19 +845,7 @@ bool OracleStrategy::prepare(const Eigen::Vector3d& start, double start_yaw) {
         }
       }
       if (pick_g < 0) break;
-      source.elements(pick_g, els);
-      for (const MaskedElement& e : els)
-        if ((e.members >> pick_b & 1u) && !sc.shown[static_cast<size_t>(e.element)])
-          sc.shown[static_cast<size_t>(e.element)] = 1, ++have;
-      const double l = len[static_cast<size_t>(m.candidates[static_cast<size_t>(pick_g)])];
-      clock += travel_time(l, cur_yaw, yaw_of(pick_b), config_.cost);
-      sc.views.emplace_back(pick_g, pick_b);
-      sc.have_after.push_back(have);
-      sc.arrival.push_back(clock);
-      sc.leg_length.push_back(l);
-      sc.legs.push_back(cell_path(cur, m.candidates[static_cast<size_t>(pick_g)], parent));
-      cur = m.candidates[static_cast<size_t>(pick_g)];
-      cur_yaw = yaw_of(pick_b);
+      take(pick_g, pick_b);
     }
     time_to_target(sc);
     return sc;
