@@ -262,6 +262,7 @@ void load(runtime::ConfigMap& m, PlannerConfig& c) {
   sf.get("doorway_radius", c.semantic_fuel.doorway_radius, 0.0, 10.0);
   sf.get("door_clusters", c.semantic_fuel.door_clusters);
   sf.get("dep_first_s", c.semantic_fuel.dep_first_s, 0.0, 1e6);
+  sf.get("tour_doors", c.semantic_fuel.tour_doors, 0, 1000);
   sf.get("greedy_ratio", c.semantic_fuel.greedy_ratio, 0.0, 1e6);
   sf.get("object_weight", c.semantic_fuel.object_weight, -1.0, 1e6);
   sf.get("door_weight", c.semantic_fuel.door_weight, 0.0, 1e6);

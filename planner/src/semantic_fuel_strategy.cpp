@@ -16,7 +16,8 @@ SemanticFuelStrategy::SemanticFuelStrategy(const PlannerConfig& config)
       yaw_rate_(config.cost.yaw_rate),
       cost_(config.cost),
       gains_(config.gain) {
-  if (rules_.dep_first_s > 0 || rules_.greedy_ratio > 0) dep_ = std::make_unique<DepStrategy>(config, false);
+  if (rules_.dep_first_s > 0 || rules_.greedy_ratio > 0 || rules_.tour_doors > 0)
+    dep_ = std::make_unique<DepStrategy>(config, false);
 }
 
 std::vector<int> door_rooms(const std::vector<std::vector<Eigen::Vector3d>>& paths,
@@ -63,6 +64,20 @@ double share_near_unfinished_objects(const std::vector<map::VoxelKey>& voxels, c
     if (near_unfinished_object(keys.center(voxels[i]), regions, margin)) ++near;
   }
   return static_cast<double>(near) / static_cast<double>(tested);
+}
+
+int count_doors(const std::vector<SemanticRegion>& regions, double radius) {
+  const int door = static_cast<int>(runtime::SemanticClass::kDoor);
+  std::vector<Eigen::Vector2d> seen;
+  for (const SemanticRegion& r : regions) {
+    if (r.class_id != door || !r.centroid.allFinite()) continue;
+    const Eigen::Vector2d c = r.centroid.head<2>();
+    const bool again = std::any_of(seen.begin(), seen.end(), [&](const Eigen::Vector2d& s) {
+      return (s - c).squaredNorm() <= radius * radius;
+    });
+    if (!again) seen.push_back(c);
+  }
+  return static_cast<int>(seen.size());
 }
 
 bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius) {
@@ -175,6 +190,7 @@ void SemanticFuelStrategy::reset() {
   turn_ = Goal();
   first_utime_ = -1;
   dep_now_ = false;
+  doors_handed_over_ = false;
 }
 
 void SemanticFuelStrategy::on_map_changes(const std::vector<map::VoxelChange>& changes) {
@@ -208,9 +224,9 @@ RoadmapView SemanticFuelStrategy::roadmap(const Goal* goal) const {
 
 PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
   if (first_utime_ < 0) first_utime_ = ctx.pose.utime;
-  if (rules_.dep_first_s > 0) {
+  if (rules_.dep_first_s > 0 || rules_.tour_doors > 0) {
     const bool was = dep_now_;
-    dep_now_ = 1e-6 * static_cast<double>(ctx.pose.utime - first_utime_) < rules_.dep_first_s;
+    dep_now_ = dep_phase(ctx);
     if (dep_now_) return dep_->plan(ctx);
     // The hand-over: FUEL plans a tour now, whatever DEP's goal was.
     if (was) ctx.need_goal = true;
@@ -234,6 +250,17 @@ PlanOutcome SemanticFuelStrategy::plan(PlanContext& ctx) {
     doors_ = open_doors(*ctx.grid, *ctx.regions, rules_.door_probe_radius, rules_.door_open_share);
   if (rules_.greedy_ratio > 0) return plan_greedy(ctx);
   return FuelStrategy::plan(ctx);
+}
+
+bool SemanticFuelStrategy::dep_phase(const PlanContext& ctx) {
+  if (rules_.dep_first_s > 0 &&
+      1e-6 * static_cast<double>(ctx.pose.utime - first_utime_) < rules_.dep_first_s)
+    return true;
+  if (rules_.tour_doors <= 0 || doors_handed_over_) return false;
+  // Once: a door that drops out of the regions (merged, or a detection withdrawn) does not send
+  // the vehicle back to DEP's order halfway through the tour.
+  doors_handed_over_ = ctx.regions && count_doors(*ctx.regions, rules_.door_radius) >= rules_.tour_doors;
+  return !doors_handed_over_;
 }
 
 double SemanticFuelStrategy::dep_rate(PlanContext& ctx, const Goal& goal) {

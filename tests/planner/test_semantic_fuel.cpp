@@ -302,6 +302,57 @@ TEST(SemanticFuel, DepFirstFliesDepsGoalUntilItsTimeThenFuelsTour) {
   EXPECT_EQ(goal(later, d, 11000000).position, f.position) << "FUEL's tour after";
 }
 
+TEST(SemanticFuel, DoorsAreCountedOncePerDoorRadius) {
+  EXPECT_EQ(count_doors({}, 1.0), 0);
+  PocketScene s;
+  SemanticRegion cabinet = s.cabinet();
+  SemanticRegion unplaced = door_at({1.0, 1.0, 1.0});
+  unplaced.centroid = Eigen::Vector3d::Constant(std::nan(""));
+  EXPECT_EQ(count_doors({cabinet, unplaced}, 1.0), 0) << "only door regions with a centroid";
+  EXPECT_EQ(count_doors({door_at({4.2, 2.0, 1.0}), door_at({4.2, 2.7, 1.0})}, 1.0), 1)
+      << "one leaf seen twice";
+  EXPECT_EQ(count_doors({door_at({4.2, 2.0, 1.0}), door_at({4.2, 3.2, 1.0})}, 1.0), 2);
+  EXPECT_EQ(count_doors({door_at({4.2, 2.0, 1.0}), door_at({4.2, 2.0, 2.5})}, 1.0), 1) << "horizontally";
+}
+
+// DEP's goal while the map shows fewer doors than tour_doors, FUEL's tour once it shows that many,
+// and for good: a door that drops out of the regions does not hand the plan back to DEP.
+TEST(SemanticFuel, TourDoorsFliesDepsGoalUntilThatManyDoorsAreSeenThenFuelsTourForGood) {
+  auto goal = [](Strategy& s, PocketScene& scene) {
+    PlanContext ctx = scene.context({1.6, 2.4, 1.2});
+    ctx.min_gain = scene.config.gain.min_gain;
+    ctx.need_goal = true;
+    return s.plan(ctx).goal;
+  };
+  const std::vector<SemanticRegion> one = {door_at({4.2, 2.0, 1.0}), door_at({4.2, 2.6, 1.0})};
+  const std::vector<SemanticRegion> two = {door_at({4.2, 2.0, 1.0}), door_at({8.0, 3.9, 1.0})};
+  PocketScene a, c;
+  DepStrategy dep(a.config, false);
+  const Goal g = goal(dep, a);
+  FuelStrategy fuel(c.config);
+  const Goal f = goal(fuel, c);
+  ASSERT_TRUE(g.valid && f.valid);
+  ASSERT_GT((f.position - g.position).norm(), 0.1) << "the scene is meant to tell DEP's goal from FUEL's";
+  {
+    PocketScene s;
+    s.config.semantic_fuel.tour_doors = 2;
+    s.regions = one;
+    SemanticFuelStrategy sem(s.config);
+    EXPECT_EQ(goal(sem, s).position, g.position) << "one door (seen as two regions): DEP's goal";
+  }
+  PocketScene s;
+  s.config.semantic_fuel.tour_doors = 2;
+  s.regions = two;
+  SemanticFuelStrategy sem(s.config);
+  EXPECT_EQ(goal(sem, s).position, f.position) << "two doors: FUEL's tour";
+  s.regions.clear();
+  s.rng = core::SplitMixRng(1);
+  EXPECT_EQ(goal(sem, s).position, f.position) << "the hand-over holds";
+  sem.reset();
+  s.rng = core::SplitMixRng(1);
+  EXPECT_EQ(goal(sem, s).position, g.position) << "until a new run";
+}
+
 // The tour's first goal is the pocket on the cabinet (a few voxels); DEP's is toward the second
 // room, whose unknown space its gain counts. With greedy_ratio DEP's goal is flown when its G / T
 // is that many times the pocket's, and the pocket when no ratio that high is met.

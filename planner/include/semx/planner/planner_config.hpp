@@ -244,6 +244,12 @@ struct SemanticFuelConfig {
   // Not semantic: DEP's goals (its roadmap, G / T) for the first dep_first_s seconds, FUEL's tour
   // after (DEP reaches 85 % of small worlds sooner, FUEL of large ones). 0: off.
   double dep_first_s = 0.0;
+  // Semantic: DEP's goals until the semantic map has shown tour_doors doors (regions of the door
+  // class, one per door_radius), FUEL's tour for good after. A door means a room behind it: with
+  // one way onward there is nothing to order and DEP's greedy look around sees the rooms soonest
+  // (it reaches 85 % of worlds of one to three rooms sooner than any tour tried); with several
+  // rooms known the tour's global order pays. 0: off.
+  int tour_doors = 0;
   // Not semantic: whenever FUEL's tour picks its next goal, DEP's best goal is flown instead when
   // its G / T is greedy_ratio times that of the tour's goal, both in DEP's measure (the volumetric
   // gain in the goal's yaw window over the travel time): the tour sees frontier clusters, and a

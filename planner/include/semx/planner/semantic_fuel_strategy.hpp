@@ -57,6 +57,9 @@ class SemanticFuelStrategy : public FuelStrategy {
   double yaw_rate_;
   CostConfig cost_;
   GainEvaluator gains_;  // dep_rate()
+  // Whether DEP decides this plan (dep_first_s, tour_doors); latches tour_doors' hand-over.
+  bool dep_phase(const PlanContext& ctx);
+
   // dep_first_s: DEP's roadmap decides until then (it is fed the map all along); greedy_ratio: it
   // decides while its goal is flown.
   std::unique_ptr<DepStrategy> dep_;
@@ -64,6 +67,7 @@ class SemanticFuelStrategy : public FuelStrategy {
   std::vector<SemanticRegion> doors_;
   int64_t first_utime_ = -1;
   bool dep_now_ = false;
+  bool doors_handed_over_ = false;  // tour_doors: the tour's for good
   int turns_done_ = 0;
   Goal turn_;  // the turn in place being flown (start_turns)
 };
@@ -83,6 +87,10 @@ bool near_unfinished_object(const Eigen::Vector3d& p, const std::vector<Semantic
 double share_near_unfinished_objects(const std::vector<map::VoxelKey>& voxels, const map::KeyMath& keys,
                                      const std::vector<SemanticRegion>& regions, double margin,
                                      size_t samples);
+
+// How many doors `regions` shows: door regions with a centroid, those within `radius`
+// (horizontally) of one counted before them one door (a leaf seen from both sides may be two).
+int count_doors(const std::vector<SemanticRegion>& regions, double radius);
 
 // Whether `p` lies within `radius` (horizontally) of a door region's centroid.
 bool near_door(const Eigen::Vector3d& p, const std::vector<SemanticRegion>& regions, double radius);
