@@ -12,6 +12,9 @@
 //  - doorway clusters (door_clusters, off: it lost): a small cluster within doorway_radius of a
 //    door region is toured with the large ones, as a pocket is: a doorway's frontier is small, the
 //    room behind it is not;
+//  - DEP until doors (tour_doors, off: measured, not the default): DEP's goals until the semantic
+//    map shows that many doors, the tour's after: a tour orders rooms, and with one way onward
+//    there is nothing to order;
 //  - and doorways first, start turns, DEP first, DEP when far better (SemanticFuelConfig says what
 //    each does).
 // Everything else is FUEL's, unchanged.
